@@ -1,0 +1,3 @@
+"""The package version, read by ``floodsph --version`` and written into every run manifest."""
+
+__version__ = "0.1.0"

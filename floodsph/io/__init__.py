@@ -1,0 +1,1 @@
+"""Reading user input files: DEM, Manning roughness, polygons."""

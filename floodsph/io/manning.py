@@ -1,0 +1,152 @@
+"""Manning's n on the DEM grid: a constant, an n raster, or land cover + a class table.
+
+Forms (flood-practice.md §1.1, as in AutoRoutePy and HydroMT mapping tables):
+
+* a number: uniform n [s m^-1/3];
+* a raster of n on any grid / CRS: reprojected onto the DEM grid, bilinear resampling;
+* a land-cover class raster + a CSV table with columns ``class,manning_n``: classes are
+  resampled nearest-neighbour (categories must never be averaged) and mapped through the
+  table. ``manning_table = "worldcover"`` selects the table shipped with floodsph for the
+  ESA WorldCover classes (``floodsph/data/worldcover_manning.csv``, textbook values).
+
+Every valid DEM cell must end up with a finite n > 0, else one InputError.
+"""
+
+from __future__ import annotations
+
+import csv
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+from rasterio.crs import CRS
+from rasterio.enums import Resampling
+from rasterio.transform import Affine
+
+from floodsph.errors import InputError
+from floodsph.io.raster import resample_onto
+
+WORLDCOVER = "worldcover"
+"""Name that selects the shipped ESA WorldCover class table."""
+
+
+def worldcover_table_path() -> Path:
+    """Path of the shipped ESA WorldCover -> Manning n table."""
+    return Path(str(resources.files("floodsph") / "data" / "worldcover_manning.csv"))
+
+
+def read_manning_table(path) -> dict[int, float]:
+    """Read a ``class,manning_n`` CSV (extra columns such as ``name`` are ignored).
+
+    Raises InputError naming the file for a missing column, a non-integer class, a
+    duplicate class or an n that is not a finite positive number.
+    """
+    path = worldcover_table_path() if str(path) == WORLDCOVER else Path(path)
+    if not path.is_file():
+        raise InputError(f"terrain.manning_table: file not found: {path}")
+    table: dict[int, float] = {}
+    with open(path, newline="") as fh:
+        reader = csv.DictReader(fh)
+        fields = [f.strip() for f in (reader.fieldnames or [])]
+        if "class" not in fields or "manning_n" not in fields:
+            raise InputError(f"manning table {path}: needs columns class,manning_n, found {fields}")
+        for line, row in enumerate(reader, start=2):
+            row = {k.strip(): (v or "").strip() for k, v in row.items() if k is not None}
+            try:
+                cls = int(row["class"])
+                n = float(row["manning_n"])
+            except ValueError:
+                raise InputError(
+                    f"manning table {path}, line {line}: class must be an integer and "
+                    f"manning_n a number, got {row['class']!r}, {row['manning_n']!r}"
+                ) from None
+            if not (np.isfinite(n) and n > 0):
+                raise InputError(f"manning table {path}, line {line}: manning_n must be > 0")
+            if cls in table:
+                raise InputError(f"manning table {path}, line {line}: class {cls} repeated")
+            table[cls] = n
+    if not table:
+        raise InputError(f"manning table {path}: no rows")
+    return table
+
+
+def manning_grid(
+    transform: Affine,
+    shape: tuple[int, int],
+    crs: CRS,
+    valid: np.ndarray,
+    *,
+    manning=0.035,
+    landcover=None,
+    manning_table=None,
+) -> np.ndarray:
+    """Manning's n [s m^-1/3] on a north-up DEM grid.
+
+    Parameters
+    ----------
+    transform, shape, crs
+        The DEM grid (north-up).
+    valid : (rows, cols) bool array
+        DEM cells inside the model; n is checked there and set to the median elsewhere.
+    manning : float or path
+        Uniform n, or an n raster (bilinear).
+    landcover, manning_table : path, optional
+        Class raster (nearest) and its CSV table or ``"worldcover"``; replace ``manning``.
+    """
+    if landcover is not None:
+        if manning_table is None:
+            raise InputError(
+                "terrain.landcover needs terrain.manning_table "
+                '(a CSV with columns class,manning_n, or "worldcover")'
+            )
+        n = _from_landcover(transform, shape, crs, valid, landcover, manning_table)
+    elif isinstance(manning, (str, Path)):
+        n = resample_onto(
+            manning, transform, shape, crs, resampling=Resampling.bilinear, what="manning raster"
+        )
+        bad = valid & ~(np.isfinite(n) & (n > 0))
+        if bad.any():
+            lo = np.nanmin(np.where(valid, n, np.nan)) if np.isfinite(n[valid]).any() else np.nan
+            raise InputError(
+                f"manning raster {manning}: {int(bad.sum())} DEM cells get no value or n <= 0 "
+                f"(minimum there {lo}); n must be > 0 over the whole DEM"
+            )
+    else:
+        try:
+            value = float(manning)
+        except (TypeError, ValueError):
+            raise InputError(
+                f"terrain.manning: expected a number or a raster path, got {manning!r}"
+            ) from None
+        if not (np.isfinite(value) and value > 0):
+            raise InputError(f"terrain.manning must be > 0, got {manning!r}")
+        return np.full(shape, value, dtype=np.float64)
+    fallback = float(np.median(n[valid])) if valid.any() else 0.035
+    return np.where(valid, n, fallback)
+
+
+def _from_landcover(transform, shape, crs, valid, landcover, manning_table) -> np.ndarray:
+    """Map nearest-resampled land-cover classes through the class table."""
+    table = read_manning_table(manning_table)
+    classes = resample_onto(
+        landcover, transform, shape, crs, resampling=Resampling.nearest, what="landcover"
+    )
+    inside = classes[valid]
+    if np.isnan(inside).any():
+        raise InputError(
+            f"landcover {landcover}: {int(np.isnan(inside).sum())} DEM cells have no land-cover "
+            "class (nodata or outside the land-cover raster)"
+        )
+    present = np.unique(inside).astype(np.int64)
+    unknown = [int(c) for c in present if int(c) not in table]
+    if unknown:
+        table_name = worldcover_table_path() if str(manning_table) == WORLDCOVER else manning_table
+        raise InputError(
+            f"landcover {landcover}: class value(s) {unknown} are not in the manning table "
+            f"{table_name}"
+        )
+    n = np.full(shape, np.nan, dtype=np.float64)
+    codes = np.where(np.isfinite(classes), classes, -1).astype(np.int64)
+    for cls, value in table.items():
+        n[codes == cls] = value
+    return n

@@ -1,0 +1,94 @@
+"""The run manifest ``run.json``: what ran, how it ended, and its key numbers.
+
+Keys (contract, ``scenario-format.md``): ``floodsph_version``, ``scenario`` (the resolved
+scenario), ``status`` (``"running"`` while the run is under way, then ``"completed"``,
+``"interrupted"`` or ``"failed"``), ``sim_time_s``, ``wall_time_s``, ``steps``,
+``particles_initial``, ``particles_max``, ``particles_final``, ``splits``, ``merges``,
+``mass_error_rel``, ``threads``; and in addition ``error`` (the message of a failed run),
+``numba_version``, ``python_version``, ``started``/``finished`` (ISO 8601, UTC),
+``particle_spacing_m`` and ``volume_*_m3`` totals.
+
+The file is written atomically (a temporary file in the same folder, then ``os.replace``), so
+a reader never sees half a manifest.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import platform
+import tempfile
+from datetime import UTC, datetime
+from pathlib import Path
+
+from floodsph._version import __version__
+
+MANIFEST_NAME = "run.json"
+
+
+def now_iso() -> str:
+    """The current UTC time in ISO 8601 with seconds."""
+    return datetime.now(UTC).isoformat(timespec="seconds")
+
+
+def new_manifest(scenario_dict: dict) -> dict:
+    """A manifest for a run that is starting (status ``"running"``)."""
+    import numba
+
+    return {
+        "floodsph_version": __version__,
+        "numba_version": numba.__version__,
+        "python_version": platform.python_version(),
+        "status": "running",
+        "error": None,
+        "started": now_iso(),
+        "finished": None,
+        "sim_time_s": 0.0,
+        "wall_time_s": 0.0,
+        "steps": 0,
+        "particles_initial": 0,
+        "particles_max": 0,
+        "particles_final": 0,
+        "splits": 0,
+        "merges": 0,
+        "mass_error_rel": None,
+        "threads": numba.get_num_threads(),
+        "scenario": scenario_dict,
+    }
+
+
+def _json_safe(value):
+    """NaN/inf (not valid JSON) to None, recursively."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _json_safe(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_safe(v) for v in value]
+    return value
+
+
+def write_manifest(folder: Path, manifest: dict) -> Path:
+    """Write ``manifest`` to ``folder/run.json`` atomically; returns the path."""
+    folder = Path(folder)
+    target = folder / MANIFEST_NAME
+    fd, tmp = tempfile.mkstemp(prefix=".run.", suffix=".json.tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            json.dump(_json_safe(manifest), f, indent=2, allow_nan=False)
+            f.write("\n")
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return target
+
+
+def read_manifest(folder: Path) -> dict | None:
+    """The manifest in ``folder``, or None if there is none (or it is unreadable)."""
+    path = Path(folder) / MANIFEST_NAME
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None

@@ -1,0 +1,135 @@
+"""Structure-of-arrays particle container with spare capacity.
+
+Every per-particle quantity is one contiguous 1-D NumPy array of length ``capacity``; the
+first ``n`` entries are the active particles. Kernels never see this class: they receive
+the array views returned by attribute access (``p.x`` is already ``x[:n]``).
+
+Positions are in the terrain's local origin (metres east and north of the lower-left
+corner of the DEM), never in raw projected coordinates, so float64 keeps millimetre
+precision over the whole run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+FIELDS: dict[str, tuple[type, str]] = {
+    "x": (np.float64, "m, local easting"),
+    "y": (np.float64, "m, local northing"),
+    "u": (np.float64, "m s-1, depth-averaged velocity east"),
+    "v": (np.float64, "m s-1, depth-averaged velocity north"),
+    "m": (np.float64, "kg, particle mass (rho_w times its water volume)"),
+    "rho": (np.float64, "kg m-2, areal density rho = rho_w d"),
+    "h": (np.float64, "m, smoothing length (never depth)"),
+    "h0": (np.float64, "m, reference smoothing length of h = h0 (rho0/rho)^(1/2)"),
+    "rho0": (np.float64, "kg m-2, reference density of the same relation"),
+    "alpha": (np.float64, "kg m-2, grad-h correction -sum m r dW/dr (= 2 rho on a lattice)"),
+    "ax": (np.float64, "m s-2, acceleration east at the last force evaluation"),
+    "ay": (np.float64, "m s-2, acceleration north at the last force evaluation"),
+    "divv": (np.float64, "s-1, SPH velocity divergence at the last force evaluation"),
+    "level": (np.int64, "refinement level: number of splits in the particle's ancestry"),
+    "born": (np.int64, "step at which the particle was created (split, merge or inflow)"),
+    "pid": (np.int64, "unique particle id, never reused"),
+}
+
+
+class ParticleSet:
+    """Particles stored as contiguous float64/int64 arrays with room to grow.
+
+    Parameters
+    ----------
+    capacity : int
+        Number of particles the arrays can hold before they are reallocated (doubled).
+    """
+
+    def __init__(self, capacity: int = 1024):
+        capacity = max(int(capacity), 1)
+        self._data = {name: np.zeros(capacity, dtype=dt) for name, (dt, _) in FIELDS.items()}
+        self.n = 0
+        self.next_pid = 0
+
+    @property
+    def capacity(self) -> int:
+        return self._data["x"].shape[0]
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        data = self.__dict__.get("_data")
+        if data is not None and name in data:
+            return data[name][: self.n]
+        raise AttributeError(name)
+
+    def __len__(self) -> int:
+        return self.n
+
+    def __repr__(self) -> str:
+        return f"ParticleSet(n={self.n}, capacity={self.capacity})"
+
+    def _reserve(self, n_total: int) -> None:
+        if n_total <= self.capacity:
+            return
+        new_cap = max(n_total, 2 * self.capacity)
+        for name, arr in self._data.items():
+            grown = np.zeros(new_cap, dtype=arr.dtype)
+            grown[: self.n] = arr[: self.n]
+            self._data[name] = grown
+
+    def append(self, **fields: np.ndarray) -> slice:
+        """Append particles; ``x, y, m, rho, h`` are required, the rest default sensibly.
+
+        ``u, v`` default to 0, ``h0``/``rho0`` to the given ``h``/``rho``, ``alpha`` to
+        2 rho (its lattice value), ``level`` to 0, ``born`` to 0. New ids are assigned.
+        Returns the slice of the new particles.
+        """
+        unknown = set(fields) - set(FIELDS)
+        if unknown:
+            raise KeyError(f"unknown particle fields: {sorted(unknown)}")
+        count = len(np.atleast_1d(fields["x"]))
+        defaults = {
+            "u": 0.0,
+            "v": 0.0,
+            "h0": fields["h"],
+            "rho0": fields["rho"],
+            "alpha": 2.0 * np.asarray(fields["rho"], dtype=np.float64),
+            "ax": 0.0,
+            "ay": 0.0,
+            "divv": 0.0,
+            "level": 0,
+            "born": 0,
+        }
+        start = self.n
+        self._reserve(start + count)
+        for name in FIELDS:
+            if name == "pid":
+                continue
+            value = fields.get(name, defaults.get(name))
+            if value is None:
+                raise KeyError(f"particle field {name!r} is required")
+            self._data[name][start : start + count] = value
+        self._data["pid"][start : start + count] = np.arange(
+            self.next_pid, self.next_pid + count, dtype=np.int64
+        )
+        self.next_pid += count
+        self.n = start + count
+        return slice(start, start + count)
+
+    def keep(self, mask: np.ndarray) -> None:
+        """Keep only the particles where ``mask`` is true, preserving their order."""
+        idx = np.flatnonzero(mask)
+        self.permute(idx)
+
+    def permute(self, order: np.ndarray) -> None:
+        """Reorder (and possibly shrink) the active particles to ``order`` (indices)."""
+        k = len(order)
+        for arr in self._data.values():
+            arr[:k] = arr[: self.n][order]
+        self.n = k
+
+    def volume(self) -> float:
+        """Total water volume sum(m) / rho_w [m3]."""
+        from floodsph.constants import RHO_WATER
+
+        return float(self.m.sum() / RHO_WATER)
+
+    def snapshot(self) -> dict[str, np.ndarray]:
+        """Copies of all active arrays (for tests and checkpoints)."""
+        return {name: arr[: self.n].copy() for name, arr in self._data.items()}

@@ -1,0 +1,84 @@
+"""The run's output recorders as simulation callbacks: map envelopes, gauges, snapshots.
+
+:class:`Recorders` owns the objects of ``floodsph.output`` for one run, hands their
+``(callback, schedule)`` pairs to the :class:`~floodsph.simulation.Simulation`, and writes the
+final files (:meth:`Recorders.write`) only when the run completes, so a failed or interrupted
+run never leaves maps that look finished. Snapshots are appended as the run goes; they carry
+the time of each frame and ``run.json`` tells whether the run completed.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from floodsph.scenario import Scenario
+from floodsph.schedules import TimeInterval
+
+GAUGES_NAME = "gauges.csv"
+SNAPSHOTS_NAME = "snapshots.nc"
+
+
+class Recorders:
+    """Envelopes (always), gauges (``[gauges]``) and snapshots (``snapshot_interval_s > 0``)."""
+
+    def __init__(self, scenario: Scenario, terrain, gauge_points, out: Path):
+        from floodsph.output.envelopes import Envelopes
+        from floodsph.output.grid import OutputGrid
+
+        self.scenario = scenario
+        self.out = Path(out)
+        wet = scenario.output.wet_threshold_m
+        self.grid = OutputGrid.from_terrain(terrain, scenario.output.resolution_m)
+        self.envelopes = Envelopes(self.grid, wet_threshold=wet)
+        self.gauges = None
+        if gauge_points is not None:
+            from floodsph.output.gauges import Gauges
+
+            self.gauges = Gauges(gauge_points, scenario.gauges.interval_s, wet_threshold=wet)
+        self.snapshots = None
+        if scenario.output.snapshot_interval_s > 0:
+            from floodsph.output.netcdf import SnapshotWriter
+
+            self.snapshots = SnapshotWriter(
+                self.out / SNAPSHOTS_NAME, self.grid, scenario=scenario.to_dict(),
+                wet_threshold=wet,
+            )
+
+    def callbacks(self) -> list:
+        """``(callable, schedule)`` pairs for the simulation."""
+        out = [(self.record_envelopes, TimeInterval(self.envelopes.interval_s))]
+        if self.gauges is not None:
+            out.append((self.record_gauges, TimeInterval(self.gauges.interval_s)))
+        if self.snapshots is not None:
+            out.append(
+                (self.record_snapshot, TimeInterval(self.scenario.output.snapshot_interval_s))
+            )
+        return out
+
+    def record_envelopes(self, sim) -> None:
+        self.envelopes.record(sim.model, force=True)
+
+    def record_gauges(self, sim) -> None:
+        self.gauges.record(sim.model, force=True)
+
+    def record_snapshot(self, sim) -> None:
+        from floodsph.output.rasterise import rasterise
+
+        p = sim.model.particles
+        d, u, v, _ = rasterise(self.grid, p.x, p.y, p.u, p.v, p.m, p.rho, p.h)
+        self.snapshots.append(sim.model.t, d, u, v)
+
+    def write(self) -> list[Path]:
+        """Write the maps (formats of ``output.formats``) and the gauge table; return paths."""
+        from floodsph.output import write_maps
+
+        formats = [f.value for f in self.scenario.output.formats]
+        written = write_maps(self.envelopes, self.out, formats, scenario=self.scenario.to_dict())
+        if self.gauges is not None:
+            written.append(self.gauges.write_csv(self.out / GAUGES_NAME))
+        return written
+
+    def close(self) -> None:
+        if self.snapshots is not None:
+            self.snapshots.close()
+            self.snapshots = None

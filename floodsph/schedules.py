@@ -1,0 +1,80 @@
+"""When a callback runs: every N steps, every T simulated seconds, every W wall-clock seconds.
+
+Schedules are small objects with ``due(sim) -> bool`` (called after every step) and
+``reset(sim)`` (called once when the simulation starts). A :class:`TimeInterval` also tells
+the simulation its next actuation time, so the time step can be shortened to land on it
+exactly (the idea of Oceananigans.jl's ``aligned_time_step``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+
+def time_tolerance(t: float) -> float:
+    """Times closer than this [s] count as equal (round-off of summed time steps)."""
+    return 1e-9 * max(1.0, abs(t))
+
+
+class IterationInterval:
+    """Due every ``n`` steps (``model.steps % n == 0``)."""
+
+    def __init__(self, n: int):
+        if int(n) < 1:
+            raise ValueError(f"IterationInterval needs n >= 1, got {n}")
+        self.n = int(n)
+
+    def reset(self, sim) -> None:
+        pass
+
+    def due(self, sim) -> bool:
+        return sim.model.steps % self.n == 0
+
+    def __repr__(self) -> str:
+        return f"IterationInterval({self.n})"
+
+
+class TimeInterval:
+    """Due at simulated times ``k * interval`` (k = 1, 2, ...) [s]."""
+
+    def __init__(self, interval: float):
+        if not interval > 0:
+            raise ValueError(f"TimeInterval needs interval > 0, got {interval}")
+        self.interval = float(interval)
+        self.next_time = self.interval
+
+    def reset(self, sim) -> None:
+        t = sim.model.t
+        self.next_time = (math.floor(t / self.interval + time_tolerance(t)) + 1) * self.interval
+
+    def due(self, sim) -> bool:
+        t = sim.model.t
+        if t < self.next_time - time_tolerance(self.next_time):
+            return False
+        self.reset(sim)
+        return True
+
+    def __repr__(self) -> str:
+        return f"TimeInterval({self.interval:g} s)"
+
+
+class WallTimeInterval:
+    """Due when ``seconds`` of wall-clock time have passed since it was last due."""
+
+    def __init__(self, seconds: float):
+        self.seconds = float(seconds)
+        self.last = time.monotonic()
+
+    def reset(self, sim) -> None:
+        self.last = time.monotonic()
+
+    def due(self, sim) -> bool:
+        now = time.monotonic()
+        if now - self.last < self.seconds:
+            return False
+        self.last = now
+        return True
+
+    def __repr__(self) -> str:
+        return f"WallTimeInterval({self.seconds:g} s)"

@@ -1,0 +1,185 @@
+"""Accelerations: the variational pressure force with shock capturing, bed and friction.
+
+Internal (pressure) acceleration with the grad-h correction (Vacondio et al. 2013 via
+Rodriguez-Paz & Bonet 2005; method notes eq. (4)), with beta_i = 2 rho_i / alpha_i:
+
+    a_i^int = - sum_j m_j [ (g beta_i / (2 rho_w) + Pi_ij / 2) grad_i W(r_ij, h_i)
+                          + (g beta_j / (2 rho_w) + Pi_ij / 2) grad_i W(r_ij, h_j) ]
+
+Shock capturing (parameter-free, Ata & Soulaimani, IJNMF 47 (2005) 139-159; method notes
+2.2 B), active for approaching pairs (v_ij . x_ij < 0):
+
+    Pi_ij = - cbar_ij (v_ij . x_ij) / (rhobar_ij sqrt(r_ij^2 + eta^2)),  eta^2 = 0.01 hbar^2
+
+Option "riemann" (method notes 2.2 C, SWE-SPHysics): g rho_i^2 / (2 rho_w) in the pressure
+term of both particles is replaced by the two-shock Riemann pressure p* = g rho_w d*^2 / 2
+(Toro) of the pair, solved along the pair axis.
+
+Both forms are antisymmetric in (i, j): internal forces conserve linear momentum exactly.
+The same loop returns the velocity divergence used for the continuity-based density guess,
+div v_i = -(2 / alpha_i) sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i).
+
+Bed and friction (pointwise, method notes eq. (5) and 2.5):
+
+    a_i = a_i^int - [(g + v.K.v + a_i^int . grad b) / (1 + |grad b|^2)] grad b
+    v  <- v / (1 + dt g n^2 |v| / max(d, d_floor)^(4/3))     (semi-implicit Manning)
+
+Units: accelerations [m s-2], rho [kg m-2], m [kg], h and r [m].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from floodsph.constants import GRAVITY, RHO_WATER
+from floodsph.sph.kernels import dwdr_cubic
+from floodsph.sph.walls import blocked, mirror
+
+LAX_FRIEDRICHS = 0
+RIEMANN = 1
+
+
+@njit(inline="always", cache=True)
+def riemann_pressure(d_l, d_r, u_l, u_r):
+    """Two-shock approximate Riemann solver (Toro): star pressure p* [N m-1 = kg s-2].
+
+    d0 = (1/g)[(c_l + c_r)/2 + (u_l - u_r)/4]^2, g_K = sqrt(g (d0 + d_K) / (2 d0 d_K)),
+    d* = (g_l d_l + g_r d_r + u_l - u_r) / (g_l + g_r), p* = g rho_w d*^2 / 2.
+    """
+    c_l = math.sqrt(GRAVITY * d_l)
+    c_r = math.sqrt(GRAVITY * d_r)
+    s = 0.5 * (c_l + c_r) + 0.25 * (u_l - u_r)
+    d0 = s * s / GRAVITY
+    if d0 <= 0.0 or d_l <= 0.0 or d_r <= 0.0:
+        return 0.0
+    g_l = math.sqrt(0.5 * GRAVITY * (d0 + d_l) / (d0 * d_l))
+    g_r = math.sqrt(0.5 * GRAVITY * (d0 + d_r) / (d0 * d_r))
+    d_star = max((g_l * d_l + g_r * d_r + u_l - u_r) / (g_l + g_r), 0.0)
+    return 0.5 * GRAVITY * RHO_WATER * d_star * d_star
+
+
+@njit(inline="always", cache=True)
+def pair_force(rx, ry, vx, vy, mj, rho_i, rho_j, alpha_i, alpha_j, h_i, h_j, scheme, acc):
+    """Add the pair term of a_i^int and of div v_i for separation r = x_i - x_j, v = v_i - v_j."""
+    r = math.sqrt(rx * rx + ry * ry)
+    if r <= 0.0:
+        return
+    beta_i = 2.0 * rho_i / alpha_i
+    beta_j = 2.0 * rho_j / alpha_j
+    fi = dwdr_cubic(r, h_i) / r
+    fj = dwdr_cubic(r, h_j) / r
+    vr = vx * rx + vy * ry
+    if scheme == RIEMANN:
+        d_i = rho_i / RHO_WATER
+        d_j = rho_j / RHO_WATER
+        # axis from i to j: u_l = v_i . e, u_r = v_j . e, so u_l - u_r = -vr / r
+        p_star = riemann_pressure(d_i, d_j, 0.0, vr / r)
+        ci = p_star * beta_i / (rho_i * rho_i)
+        cj = p_star * beta_j / (rho_j * rho_j)
+    else:
+        k = 0.5 * GRAVITY / RHO_WATER
+        ci = k * beta_i
+        cj = k * beta_j
+        if vr < 0.0:
+            hbar = 0.5 * (h_i + h_j)
+            cbar = 0.5 * (math.sqrt(GRAVITY * rho_i / RHO_WATER)
+                          + math.sqrt(GRAVITY * rho_j / RHO_WATER))
+            pi_ij = -cbar * vr / (0.5 * (rho_i + rho_j) * math.sqrt(r * r + 0.01 * hbar * hbar))
+            ci += 0.5 * pi_ij
+            cj += 0.5 * pi_ij
+    f = mj * (ci * fi + cj * fj)
+    acc[0] -= f * rx
+    acc[1] -= f * ry
+    acc[2] -= mj * fi * vr
+
+
+@njit(parallel=True, cache=True)
+def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, wstart, wseg, seg, scheme,
+                          ax, ay, divv):
+    """a^int and div v of every particle (gather form), mirror images included."""
+    for i in prange(x.shape[0]):
+        xi = x[i]
+        yi = y[i]
+        acc = np.zeros(3)
+        near_wall = wstart[i + 1] > wstart[i]
+        for q in range(nstart[i], nstart[i + 1]):
+            j = nbr[q]
+            if near_wall and blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
+                continue
+            pair_force(xi - x[j], yi - y[j], u[i] - u[j], v[i] - v[j], m[j], rho[i], rho[j],
+                       alpha[i], alpha[j], h[i], h[j], scheme, acc)
+        for w in range(wstart[i], wstart[i + 1]):
+            s = wseg[w]
+            _image_force(i, i, x, y, u, v, m, rho, alpha, h, seg, s, scheme, acc)
+            for q in range(nstart[i], nstart[i + 1]):
+                j = nbr[q]
+                if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
+                    continue
+                _image_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s, scheme, acc)
+        ax[i] = acc[0]
+        ay[i] = acc[1]
+        divv[i] = 2.0 * acc[2] / alpha[i]
+
+
+@njit(inline="always", cache=True)
+def _image_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s, scheme, acc):
+    xm, ym, on, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+    if not on:
+        return
+    vn = u[j] * nx + v[j] * ny
+    um = u[j] - 2.0 * vn * nx
+    vm = v[j] - 2.0 * vn * ny
+    pair_force(x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, m[j], rho[i], rho[j], alpha[i],
+               alpha[j], h[i], h[j], scheme, acc)
+
+
+@njit(parallel=True, cache=True)
+def add_bed_acceleration(u, v, bed, max_slope, ax, ay):
+    """Add the bed term of (5) to the internal accelerations (in place).
+
+    ``bed`` is the (n, 7) sample of ``floodsph.sph.bed.sample_bed``. The slope is limited to
+    ``max_slope`` in magnitude, and the normal-force factor to >= 0 (a column cannot be pulled
+    into the bed).
+    """
+    for i in prange(u.shape[0]):
+        bx = bed[i, 1]
+        by = bed[i, 2]
+        s = math.sqrt(bx * bx + by * by)
+        if s > max_slope:
+            bx *= max_slope / s
+            by *= max_slope / s
+        vkv = u[i] * (bed[i, 3] * u[i] + bed[i, 4] * v[i]) + v[i] * (bed[i, 4] * u[i]
+                                                                      + bed[i, 5] * v[i])
+        f = (GRAVITY + vkv + ax[i] * bx + ay[i] * by) / (1.0 + bx * bx + by * by)
+        f = max(f, 0.0)
+        ax[i] -= f * bx
+        ay[i] -= f * by
+
+
+@njit(parallel=True, cache=True)
+def apply_friction(u, v, rho, manning, dt, d_floor):
+    """Semi-implicit Manning friction: v <- v / (1 + dt g n^2 |v| / max(d, d_floor)^(4/3))."""
+    for i in prange(u.shape[0]):
+        n = manning[i]
+        if n <= 0.0:
+            continue
+        d = max(rho[i] / RHO_WATER, d_floor)
+        speed = math.sqrt(u[i] * u[i] + v[i] * v[i])
+        k = 1.0 / (1.0 + dt * GRAVITY * n * n * speed / d ** (4.0 / 3.0))
+        u[i] *= k
+        v[i] *= k
+
+
+@njit(parallel=True, cache=True)
+def stable_dt(u, v, rho, h, cfl):
+    """CFL time step dt = cfl min_i h_i / (|v_i| + c_i), c_i = sqrt(g d_i) [s]."""
+    best = np.inf
+    for i in prange(u.shape[0]):
+        c = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
+        w = math.sqrt(u[i] * u[i] + v[i] * v[i]) + c
+        if w > 0.0:
+            best = min(best, h[i] / w)
+    return cfl * best

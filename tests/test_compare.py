@@ -1,0 +1,122 @@
+"""Map comparison: contingency scores on hand-built maps, alignment of shifted grids, CLI."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+import rasterio
+from click.testing import CliRunner
+from rasterio.crs import CRS
+from rasterio.transform import from_origin
+
+from floodsph.cli.compare import command
+from floodsph.compare import compare, scores
+from floodsph.errors import InputError
+
+CELL = 10.0
+WEST, NORTH = 500000.0, 4200000.0
+
+
+def write(path, data, west=WEST, north=NORTH, crs="EPSG:32633", desc=None):
+    profile = {"driver": "GTiff", "width": data.shape[1], "height": data.shape[0], "count": 1,
+               "dtype": str(data.dtype), "crs": crs,
+               "transform": from_origin(west, north, CELL, CELL),
+               "nodata": 0 if data.dtype == np.uint8 else float("nan")}
+    with rasterio.open(path, "w", **profile) as dst:
+        dst.write(data, 1)
+        if desc:
+            dst.set_band_description(1, desc)
+    return path
+
+
+def test_scores_from_counts_by_hand():
+    s = scores(hits=6, false_alarms=3, misses=2, correct_negatives=89)
+    assert s["hit_rate"] == pytest.approx(6 / 8)
+    assert s["false_alarm_ratio"] == pytest.approx(3 / 9)
+    assert s["csi"] == pytest.approx(6 / 11)
+    assert s["f2"] == pytest.approx(3 / 11)
+    assert s["error_bias"] == pytest.approx(1.5)
+    assert scores(4, 2, 0)["error_bias"] == math.inf
+    assert math.isnan(scores(0, 0, 0)["csi"])
+
+
+def test_hand_built_maps_counts_and_depth_errors(tmp_path):
+    a = np.full((10, 10), np.nan, dtype=np.float32)
+    b = np.full((10, 10), np.nan, dtype=np.float32)
+    a[0, :6] = 1.0          # 6 cells wet in both ...
+    b[0, :6] = 0.5          # ... with model - reference = 0.5 m
+    a[1, :3] = 0.2          # 3 false alarms
+    b[2, :2] = 0.3          # 2 misses
+    a[3, 0] = 0.05          # below the 0.1 m threshold: dry, not a false alarm
+    r = compare(write(tmp_path / "a.tif", a), write(tmp_path / "b.tif", b), threshold=0.1)
+    s = r.summary
+    assert (s["hits"], s["false_alarms"], s["misses"], s["correct_negatives"]) == (6, 3, 2, 89)
+    assert s["csi"] == pytest.approx(6 / 11) and s["f2"] == pytest.approx(3 / 11)
+    assert s["depth"] == {"n": 6, "rmse": pytest.approx(0.5), "bias": pytest.approx(0.5),
+                          "mae": pytest.approx(0.5)}
+    assert r.difference[2, 0] == pytest.approx(-0.3) and np.isnan(r.difference[5, 5])
+
+
+@pytest.mark.parametrize("k", [1, 5])
+def test_reference_shifted_by_k_cells_gives_hand_computed_csi(tmp_path, k):
+    """A 20 x 10 wet block against itself moved k cells east: hits 10 (20 - k), etc."""
+    depth = np.zeros((40, 60), dtype=np.float32)
+    depth[10:20, 10:30] = 1.0
+    model = write(tmp_path / "model.tif", depth)
+    ref = write(tmp_path / "ref.tif", depth, west=WEST + k * CELL)
+    s = compare(model, ref, threshold=0.1).summary
+    assert (s["hits"], s["false_alarms"], s["misses"]) == (10 * (20 - k), 10 * k, 10 * k)
+    assert s["cells_compared"] == 40 * (60 - k)      # the reference covers columns k..59
+    assert s["csi"] == pytest.approx((20 - k) / (20 + k))
+    assert s["depth"]["rmse"] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_arrival_maps_and_points(tmp_path):
+    a = np.full((5, 5), np.nan, dtype=np.float32)
+    a[:, :3] = 60.0
+    b = a.copy()
+    b[:, :2] = 90.0
+    pa = write(tmp_path / "a.tif", a, desc="arrival_time")
+    pb = write(tmp_path / "b.tif", b, desc="arrival_time")
+    s = compare(pa, pb).summary
+    assert s["kind"] == "arrival" and s["arrival"]["n"] == 15
+    assert s["arrival"]["bias"] == pytest.approx(-30.0 * 10 / 15)
+    depth = np.zeros((5, 5), dtype=np.float32)
+    depth[:, 0] = 2.0
+    obs = tmp_path / "hwm.csv"
+    obs.write_text(f"id,x,y,observed\nP1,{WEST + 5},{NORTH - 15},1.5\n"
+                   f"P2,{WEST + 25},{NORTH - 15},0.5\n")
+    pd = write(tmp_path / "d.tif", depth)
+    s = compare(pd, pd, points=obs).summary
+    # P1: 2.0 - 1.5 = 0.5; P2 is on a dry cell (depth 0): 0 - 0.5 = -0.5.
+    assert s["points"]["n"] == 2 and s["points"]["bias"] == pytest.approx(0.0)
+    assert s["points"]["rmse"] == pytest.approx(0.5)
+
+
+def test_rasters_without_crs_or_overlap_are_refused(tmp_path):
+    d = np.ones((4, 4), dtype=np.float32)
+    good = write(tmp_path / "good.tif", d)
+    bare = write(tmp_path / "bare.tif", d, crs=None)
+    with pytest.raises(InputError, match=r"bare\.tif: the raster has no CRS"):
+        compare(good, bare)
+    far = write(tmp_path / "far.tif", d, west=WEST + 1e5)
+    with pytest.raises(InputError, match=r"good\.tif and .*far\.tif do not overlap"):
+        compare(good, far)
+
+
+def test_cli_prints_table_and_writes_outputs(tmp_path):
+    depth = np.zeros((30, 30), dtype=np.float32)
+    depth[5:15, 5:15] = 0.8
+    a = write(tmp_path / "a.tif", depth)
+    b = write(tmp_path / "b.tif", np.roll(depth, 2, axis=1))
+    out = tmp_path / "cmp"
+    result = CliRunner().invoke(command, [str(a), str(b), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "csi" in result.output and "0.6667" in result.output     # 80 / 120
+    summary = json.loads((out / "comparison.json").read_text())
+    assert summary["hits"] == 80 and summary["misses"] == 20
+    with rasterio.open(out / "difference.tif") as src:
+        assert src.crs == CRS.from_epsg(32633)
+        assert src.read(1)[5, 5] == pytest.approx(0.8)
+    assert (out / "comparison.png").stat().st_size > 0

@@ -1,0 +1,76 @@
+"""SPH -> grid interpolation: exact for uniform fields, honest extent at the water's edge."""
+
+import numpy as np
+import pytest
+
+from floodsph.constants import RHO_WATER
+from floodsph.output.grid import OutputGrid
+from floodsph.output.rasterise import interpolate, rasterise
+from floodsph.sph.kernels import w_cubic
+from floodsph.terrain import Terrain
+
+KAPPA = 1.3
+
+
+def lattice(x0, x1, y0, y1, dx, d, u=0.0, v=0.0):
+    """Square lattice of particles covering [x0, x1] x [y0, y1] with uniform depth d."""
+    gx = np.arange(x0 + dx / 2, x1, dx)
+    gy = np.arange(y0 + dx / 2, y1, dx)
+    X, Y = np.meshgrid(gx, gy)
+    n = X.size
+    rho = np.full(n, RHO_WATER * d)
+    return dict(x=X.ravel(), y=Y.ravel(), u=np.full(n, u), v=np.full(n, v), m=rho * dx * dx,
+                rho=rho, h=np.full(n, KAPPA * dx))
+
+
+def test_uniform_lattice_gives_its_depth_inside_and_nan_beyond_support():
+    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, 100), (0, 80), 2.0)
+    grid = OutputGrid.from_terrain(terrain)
+    p = lattice(20.0, 60.0, 10.0, 50.0, 1.0, 0.7, u=0.3, v=-0.2)
+    d, u, v, support = rasterise(grid, **p)
+    xc, yc = grid.cell_centres()
+    X, Y = np.meshgrid(xc, yc)
+    inside = (X > 23) & (X < 57) & (Y > 13) & (Y < 47)
+    np.testing.assert_allclose(d[inside], 0.7, atol=1e-6)
+    np.testing.assert_allclose(u[inside], 0.3, atol=1e-6)
+    np.testing.assert_allclose(v[inside], -0.2, atol=1e-6)
+    far = (X < 20 - 2 * KAPPA) | (X > 60 + 2 * KAPPA) | (Y < 10 - 2 * KAPPA) | (Y > 50 + 2 * KAPPA)
+    assert np.all(np.isnan(d[far])) and np.all(support[far] == 0.0)
+
+
+def test_mapped_extent_follows_the_edge_of_the_water():
+    """The half-support contour sits on the water's edge: x = 40 for particles up to 39.5."""
+    p = lattice(0.0, 40.0, 0.0, 40.0, 1.0, 0.5)
+    px = np.array([38.0, 39.5, 39.9, 40.5, 41.0, 42.0])
+    d, _, _, support = interpolate(px, np.full(px.size, 20.0), **p)
+    np.testing.assert_allclose(d[:3], 0.5, atol=1e-9)
+    assert np.all(np.isnan(d[3:]))
+    assert support[2] > 0.5 > support[3]
+
+
+def test_a_few_huge_smoothing_lengths_are_found():
+    """Particles with h far above the rest (binned separately) still reach distant cells."""
+    p = lattice(0.0, 20.0, 0.0, 20.0, 1.0, 1.0)
+    big = {k: np.array([val]) for k, val in
+           dict(x=60.0, y=10.0, u=2.0, v=0.0, m=RHO_WATER * 0.2 * 400.0, rho=RHO_WATER * 0.2,
+                h=KAPPA * 20.0).items()}
+    q = {k: np.concatenate([p[k], big[k]]) for k in p}
+    d, u, _, support = interpolate(np.array([60.0, 85.0]), np.array([10.0, 10.0]), **q)
+    # Only the big particle reaches these points; at x = 60 its V W(0) alone is 0.19 < 0.5.
+    assert support[0] == pytest.approx(400.0 * w_cubic(0.0, KAPPA * 20.0), rel=1e-12)
+    assert support[1] == pytest.approx(400.0 * w_cubic(25.0, KAPPA * 20.0), rel=1e-12)
+    assert np.isnan(d[0])
+    d, u, _, _ = interpolate(np.array([60.0]), np.array([10.0]), **q, min_support=0.1)
+    assert d[0] == pytest.approx(0.2) and u[0] == pytest.approx(2.0)
+
+
+def test_resampled_grid_is_aligned_to_the_dem_origin():
+    terrain = Terrain.from_function(lambda x, y: 0.5 * x + 2.0 * y, (100, 130), (200, 221), 1.0)
+    grid = OutputGrid.from_terrain(terrain, resolution_m=4.0)
+    assert (grid.nx, grid.ny) == (8, 6)
+    assert (grid.x0, grid.y0) == (100.0, 200.0)
+    xc, yc = grid.cell_centres()
+    # A plane is reproduced exactly by bilinear interpolation (inside the node range).
+    X, Y = np.meshgrid(xc + 100, yc + 200)
+    inner = (X < 129.5) & (Y < 220.5)
+    np.testing.assert_allclose(grid.bed[inner], (0.5 * X + 2.0 * Y)[inner])

@@ -1,0 +1,180 @@
+"""Scenario TOML: defaults, path resolution, the resolved copy, and exact error messages."""
+
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+from conftest import BASE_SCENARIO, X0, Y0
+
+from floodsph.errors import InputError
+from floodsph.scenario import (
+    Edges,
+    OutputFormat,
+    Refinement,
+    load_scenario,
+    write_resolved,
+)
+from floodsph.toml_writer import dumps
+
+MINIMAL = """\
+[scenario]
+name = "mini"
+end_time_s = 60
+
+[terrain]
+dem = "dem.tif"
+"""
+
+
+def test_defaults_and_relative_paths(write_scenario, tmp_path):
+    sc = load_scenario(write_scenario(MINIMAL))
+    assert sc.terrain.dem == (tmp_path / "dem.tif").resolve()
+    assert sc.end_time_s == 60.0 and isinstance(sc.end_time_s, float)
+    assert sc.terrain.manning == 0.035
+    assert sc.terrain.edges is Edges.OPEN
+    assert sc.numerics.cfl == 0.3
+    assert sc.numerics.refinement is Refinement.SPLIT_COALESCE
+    assert sc.numerics.particle_spacing_m is None
+    assert sc.output.wet_threshold_m == 0.01
+    assert sc.output.formats == (OutputFormat.GEOTIFF, OutputFormat.NETCDF)
+    assert sc.output_directory == tmp_path.resolve() / "out" / "mini"
+    assert sc.initial_water == () and sc.inflows == () and sc.gauges is None
+
+
+def test_output_directory_relative_to_scenario(write_scenario, tmp_path):
+    sc = load_scenario(write_scenario(MINIMAL + '\n[output]\ndirectory = "runs/a"\n'))
+    assert sc.output_directory == tmp_path.resolve() / "runs" / "a"
+
+
+def test_resolved_copy_reloads_to_the_same_scenario(scenario_file, tmp_path):
+    sc = load_scenario(scenario_file)
+    other = tmp_path / "elsewhere"
+    other.mkdir()
+    write_resolved(sc, other / "scenario.resolved.toml")
+    again = load_scenario(other / "scenario.resolved.toml")
+    assert again.to_dict() == sc.to_dict()
+    assert again.initial_water[0].polygon[1] == (X0 + 400.0, Y0)
+
+
+def test_toml_writer_escapes_strings():
+    data = {"a": {"s": 'quote " back \\ tab \t é', "n": [1, 2.5], "b": True},
+            "t": [{"x": 1}, {"x": 2, "sub": {"k": "v"}}]}
+    assert tomllib.loads(dumps(data)) == data
+
+
+def error_of(write_scenario, text) -> str:
+    with pytest.raises(InputError) as err:
+        load_scenario(write_scenario(text))
+    return str(err.value)
+
+
+POLY = "[[0, 0], [10, 0], [10, 10]]"
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (("end_time_s = 20.0", 'end_time_s = "ten"'),
+         "scenario.end_time_s: expected a number, got string 'ten'"),
+        (("end_time_s = 20.0", "end_time_s = 0"), "scenario.end_time_s: must be > 0, got 0"),
+        (("end_time_s = 20.0", "end_time_s = nan"),
+         "scenario.end_time_s: expected a finite number, got nan"),
+        (("cfl = 0.3", "cfl = 2"), "numerics.cfl: must be <= 1, got 2"),
+        (("cfl = 0.3", "cfl = true"), "numerics.cfl: expected a number, got boolean True"),
+        (("particle_spacing_m = 10.0", "particle_spacing_m = -1"),
+         "numerics.particle_spacing_m: must be > 0, got -1"),
+        (('refinement = "none"', 'refinement = "lots"'),
+         "numerics.refinement: expected one of 'split+coalesce', 'split', 'none', "
+         "got string 'lots'"),
+        (('edges = "closed"', 'edges = "sometimes"'),
+         "terrain.edges: expected one of 'open', 'closed', got string 'sometimes'"),
+        (("resolution_m = 10.0", "wet_threshold_m = -0.1"),
+         "output.wet_threshold_m: must be >= 0, got -0.1"),
+        (("resolution_m = 10.0", 'formats = ["geotiff", "png"]'),
+         "output.formats[1]: expected one of 'geotiff', 'netcdf', got string 'png'"),
+        (("manning = 0.03", "manning = 0"), "terrain.manning: must be > 0, got 0"),
+        (("manning = 0.03", 'manning = "n.tif"'), "terrain.manning: file not found: "),
+        (('name = "valley"', 'name = "a/b"'), "scenario.name: must be a non-empty folder name"),
+        (('name = "valley"\n', ""), "scenario.name: required key is missing"),
+        (("cfl = 0.3", "cfll = 0.3"),
+         "numerics.cfll: unknown key; allowed keys: cfl, density_tol, "),
+        (("[scenario]", "bogus = 1\n[scenario]"),
+         "bogus: unknown key; allowed keys: gauges, inflows, initial_water, numerics, output, "
+         "scenario, sinks, terrain, walls"),
+        (("level_m = 100.0", "level_m = 100.0\ncolour = 1"),
+         "initial_water[0].colour: unknown key; allowed keys: depth, level_m, polygon"),
+    ],
+)
+def test_bad_values_name_the_key(write_scenario, change, message):
+    text = BASE_SCENARIO.replace(*change)
+    assert text != BASE_SCENARIO
+    assert error_of(write_scenario, text).startswith(
+        f"{write_scenario().parent / 'scenario.toml'}: "
+    )
+    assert message in error_of(write_scenario, text)
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        ("[[walls]]\npolyline = [[0, 0]]\n",
+         "walls[0].polyline: expected at least 2 [x, y] points, got 1"),
+        ("[[walls]]\npolyline = [[0, 0], [1, \"x\"]]\n",
+         "walls[0].polyline[1][1]: expected a finite number, got string 'x'"),
+        ("[[sinks]]\npolygon = [[0, 0], [1, 1]]\n",
+         "sinks[0].polygon: expected at least 3 [x, y] points, got 2"),
+        ("[[sinks]]\npolygon = [[0, 0], [1, 1], [2, 2]]\n",
+         "sinks[0].polygon: polygon encloses no area (its points are collinear)"),
+        ("[[inflows]]\nline = [[0, 0]]\nhydrograph = \"q.csv\"\n",
+         "inflows[0].line: expected two [x, y] points, got 1"),
+        ("[[inflows]]\nline = [[0, 0], [0, 0]]\nhydrograph = \"q.csv\"\n",
+         "inflows[0].line: the two end points are the same"),
+        ("[[inflows]]\nline = [[0, 0], [1, 0]]\n",
+         "inflows[0]: expected exactly one of hydrograph (a CSV file) or [breach]"),
+        ("[[inflows]]\nline = [[0, 0], [1, 0]]\nhydrograph = \"q.csv\"\n",
+         "inflows[0].hydrograph: file not found: "),
+        ("[[inflows]]\nline = [[0, 0], [1, 0]]\nhydrograph = \"dem.tif\"\ndirection = [0, 0]\n",
+         "inflows[0].direction: must not be the zero vector"),
+        ("[gauges]\nfile = \"g.csv\"\n", "gauges.file: file not found: "),
+        ("[[initial_water]]\nlevel_m = 3\n",
+         "initial_water[1].polygon: required with level_m (the area to fill)"),
+        (f"[[initial_water]]\nlevel_m = 3\npolygon = {POLY}\ndepth = \"d.tif\"\n",
+         "initial_water[1].depth: give either depth or level_m + polygon, not both"),
+        ("walls = 3\n", "walls: expected an array of tables [[walls]], got integer 3"),
+    ],
+)
+def test_bad_geometry_names_the_key(write_scenario, extra, message):
+    # Top-level keys must come before the first table; arrays of tables go at the end.
+    text = extra + BASE_SCENARIO if not extra.startswith("[") else BASE_SCENARIO + extra
+    assert message in error_of(write_scenario, text)
+
+
+def test_invalid_toml_names_line_and_column(write_scenario):
+    text = BASE_SCENARIO.replace("end_time_s = 20.0", "end_time_s = = 20.0")
+    message = error_of(write_scenario, text)
+    assert "scenario.toml: invalid TOML" in message
+    assert "line 3, column" in message
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(InputError, match="nope.toml: scenario file not found"):
+        load_scenario(tmp_path / "nope.toml")
+
+
+def test_missing_required_tables(write_scenario):
+    assert "scenario: required table [scenario] is missing" in error_of(
+        write_scenario, "[terrain]\ndem = 'dem.tif'\n"
+    )
+    assert "terrain: required table [terrain] is missing" in error_of(
+        write_scenario, "[scenario]\nname = 'a'\nend_time_s = 1\n"
+    )
+
+
+def test_hydrograph_is_read_at_load(write_scenario, tmp_path):
+    (tmp_path / "q.csv").write_text("time_s,discharge_m3s\n0,0\n10,5\n5,1\n")
+    text = BASE_SCENARIO + f"[[inflows]]\nline = [[{X0}, {Y0}], [{X0}, {Y0 + 50}]]\n" \
+        'hydrograph = "q.csv"\n'
+    message = error_of(write_scenario, text)
+    assert message.startswith(f"{tmp_path / 'scenario.toml'}: inflows[0].hydrograph: ")
+    assert "line 4" in message and "times must increase strictly" in message
