@@ -78,6 +78,15 @@ class Recorders:
             written.append(self.gauges.write_csv(self.out / GAUGES_NAME))
         return written
 
+    def write_pictures(self) -> list[str] | str:
+        """Quick-look PNGs of the envelopes; their names, or ``"skipped: <reason>"``."""
+        from floodsph.output import write_pictures
+
+        result = write_pictures(self.envelopes, self.out, title=self.scenario.name)
+        if isinstance(result, str):
+            return "skipped: " + result.removeprefix("pictures skipped: ")
+        return [Path(path).name for path in result]
+
     def close(self) -> None:
         if self.snapshots is not None:
             self.snapshots.close()

@@ -28,6 +28,8 @@ from floodsph.schedules import time_tolerance
 log = logging.getLogger(__name__)
 
 LOG_NAME = "floodsph.log"
+#: Quick-look PNGs written by ``floodsph.output.write_pictures`` when matplotlib is installed.
+PICTURE_NAMES = ("max_depth.png", "hazard_uk.png", "hazard_arr.png", "arrival_time.png")
 RESOLVED_NAME = "scenario.resolved.toml"
 MASS_BALANCE_NAME = "mass_balance.csv"
 #: Files of the run folder (scenario-format.md) removed before a new run writes its own.
@@ -48,6 +50,7 @@ RUN_FILES = (
     "run.json",
     RESOLVED_NAME,
     LOG_NAME,
+    *PICTURE_NAMES,
 )
 PROGRESS_BAR_S = 0.5
 PROGRESS_LOG_S = 30.0
@@ -121,6 +124,9 @@ def run_scenario(
             probe.close()
         written = probes[-1].write()
         log.info("wrote %d map and gauge files", len(written))
+        manifest["pictures"] = probes[-1].write_pictures()
+        if isinstance(manifest["pictures"], str):
+            log.warning("quick-look %s", manifest["pictures"])
         manifest["status"] = "completed"
         manifest["end_time_reached"] = model.t >= scenario.end_time_s - time_tolerance(
             scenario.end_time_s

@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import dwdr_cubic, w_cubic
-from floodsph.sph.walls import blocked, mirror
+from floodsph.sph.walls import blocked, corner_image, wall_image
 
 
 @njit(inline="always", cache=True)
@@ -62,15 +62,30 @@ def summation(idx, x, y, m, h, nstart, nbr, wstart, wseg, seg, out_sum, out_alph
                 if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
                     continue
                 _add_image(i, j, x, y, m, hi, seg, s, acc)
+            for w2 in range(w + 1, wstart[i + 1]):
+                s2 = wseg[w2]
+                _add_corner(i, i, x, y, m, hi, seg, s, s2, acc)
+                for q in range(nstart[i], nstart[i + 1]):
+                    j = nbr[q]
+                    if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
+                        continue
+                    _add_corner(i, j, x, y, m, hi, seg, s, s2, acc)
         out_sum[i] = acc[0]
         out_alpha[i] = acc[1]
 
 
 @njit(inline="always", cache=True)
 def _add_image(i, j, x, y, m, hi, seg, s, acc):
-    xm, ym, on, _, _ = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-    if on:
+    xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
+    if ok:
         _add_pair(x[i] - xm, y[i] - ym, m[j], hi, acc)
+
+
+@njit(inline="always", cache=True)
+def _add_corner(i, j, x, y, m, hi, seg, s1, s2, acc):
+    xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
+    if ok:
+        _add_pair(x[i] - xc, y[i] - yc, m[j], hi, acc)
 
 
 @njit(parallel=True, cache=True)

@@ -36,7 +36,7 @@ from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.kernels import dwdr_cubic
-from floodsph.sph.walls import blocked, mirror
+from floodsph.sph.walls import blocked, corner_image, mirror, wall_image
 
 LAX_FRIEDRICHS = 0
 RIEMANN = 1
@@ -119,6 +119,14 @@ def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, wstart, wse
                 if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
                     continue
                 _image_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s, scheme, acc)
+            for w2 in range(w + 1, wstart[i + 1]):
+                s2 = wseg[w2]
+                _corner_force(i, i, x, y, u, v, m, rho, alpha, h, seg, s, s2, scheme, acc)
+                for q in range(nstart[i], nstart[i + 1]):
+                    j = nbr[q]
+                    if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
+                        continue
+                    _corner_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s, s2, scheme, acc)
         ax[i] = acc[0]
         ay[i] = acc[1]
         divv[i] = 2.0 * acc[2] / alpha[i]
@@ -126,13 +134,32 @@ def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, wstart, wse
 
 @njit(inline="always", cache=True)
 def _image_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s, scheme, acc):
-    xm, ym, on, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-    if not on:
+    xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
+    if not ok:
         return
+    _, _, _, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
     vn = u[j] * nx + v[j] * ny
     um = u[j] - 2.0 * vn * nx
     vm = v[j] - 2.0 * vn * ny
     pair_force(x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, m[j], rho[i], rho[j], alpha[i],
+               alpha[j], h[i], h[j], scheme, acc)
+
+
+@njit(inline="always", cache=True)
+def _corner_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s1, s2, scheme, acc):
+    xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
+    if not ok:
+        return
+    # two reflections of the velocity: about s1's normal, then s2's
+    _, _, _, n1x, n1y = mirror(x[j], y[j], seg[s1, 0], seg[s1, 1], seg[s1, 2], seg[s1, 3])
+    _, _, _, n2x, n2y = mirror(x[j], y[j], seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
+    vn = u[j] * n1x + v[j] * n1y
+    um = u[j] - 2.0 * vn * n1x
+    vm = v[j] - 2.0 * vn * n1y
+    vn = um * n2x + vm * n2y
+    um -= 2.0 * vn * n2x
+    vm -= 2.0 * vn * n2y
+    pair_force(x[i] - xc, y[i] - yc, u[i] - um, v[i] - vm, m[j], rho[i], rho[j], alpha[i],
                alpha[j], h[i], h[j], scheme, acc)
 
 

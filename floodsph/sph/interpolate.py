@@ -20,7 +20,7 @@ from numba import njit, prange
 from floodsph.constants import RHO_WATER
 from floodsph.sph.kernels import w_cubic
 from floodsph.sph.neighbours import CellGrid
-from floodsph.sph.walls import crosses, mirror, segment_distance
+from floodsph.sph.walls import crosses, segment_distance, wall_image
 
 
 @njit(parallel=True, cache=True)
@@ -51,9 +51,8 @@ def _field(qx, qy, x, y, u, v, m, rho, h, cell_start, order, xmin, ymin, cell, n
                     for w in range(seg.shape[0]):
                         if segment_distance(px, py, seg[w, 0], seg[w, 1], seg[w, 2],
                                             seg[w, 3]) < 2.0 * h[j]:
-                            xm, ym, on, _, _ = mirror(x[j], y[j], seg[w, 0], seg[w, 1],
-                                                      seg[w, 2], seg[w, 3])
-                            if on:
+                            xm, ym, ok = wall_image(px, py, x[j], y[j], seg, w)
+                            if ok:
                                 wk += w_cubic(np.hypot(px - xm, py - ym), h[j])
                     vol = m[j] / rho[j] * wk
                     dsum += vol * rho[j]

@@ -10,6 +10,11 @@ the edges are closed. Three mechanisms keep water on its side:
    wall this completes the kernel exactly, so the depth and the pressure of still water along
    a wall are those of the interior (zero-order consistency, the property the modified virtual
    boundary particles of Vacondio, Rogers & Stansby, IJNMF 69 (2012) 226-253 approximate).
+   An image counts only if the line from i to it passes through the segment that made it,
+   so that behind a convex corner (a building's) each point is imaged once, not by both faces.
+   In a corner where two near segments meet, j's foot on both gives a third image, the
+   reflection of j's first image about the second wall (the point reflection through a
+   right-angled corner), which completes the kernel there too.
 2. **Pair blocking.** Particles on opposite sides of a wall do not interact.
 3. **Crossing guard.** A drift step that would cross a wall is reflected about it (position and
    normal velocity), so no particle ever crosses, whatever the time step.
@@ -171,6 +176,36 @@ def mirror(px, py, x1, y1, x2, y2):
     fy = y1 + t * ey
     inv = 1.0 / math.sqrt(ll)
     return 2.0 * fx - px, 2.0 * fy - py, 0.0 <= t <= 1.0, -ey * inv, ex * inv
+
+
+@njit(inline="always", cache=True)
+def wall_image(xi, yi, px, py, seg, s):
+    """Mirror image of p about segment s as seen from particle i: (x', y', ok).
+
+    ok requires p's foot on the segment and the line from i to the image to pass through it.
+    """
+    xm, ym, on, _, _ = mirror(px, py, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+    ok = on and crosses(xi, yi, xm, ym, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+    return xm, ym, ok
+
+
+@njit(inline="always", cache=True)
+def corner_image(px, py, seg, s1, s2):
+    """Double mirror image of p about segments s1 then s2 if they share a vertex.
+
+    Returns (x'', y'', ok): ok is False unless the segments meet and p's foot lies on both.
+    """
+    shared = False
+    for a in range(2):
+        for b in range(2):
+            if seg[s1, 2 * a] == seg[s2, 2 * b] and seg[s1, 2 * a + 1] == seg[s2, 2 * b + 1]:
+                shared = True
+    if not shared:
+        return px, py, False
+    x1, y1, on1, _, _ = mirror(px, py, seg[s1, 0], seg[s1, 1], seg[s1, 2], seg[s1, 3])
+    _, _, on2, _, _ = mirror(px, py, seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
+    x2, y2, _, _, _ = mirror(x1, y1, seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
+    return x2, y2, on1 and on2
 
 
 @njit(parallel=True, cache=True)

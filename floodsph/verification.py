@@ -1,0 +1,148 @@
+"""Analytic verification cases run through the real solver path (terrain, particles, model).
+
+Each case builds a ``FloodModel`` on an analytic bed with ``Terrain.from_function``, runs it
+and returns the error against the exact solution of ``floodsph.testing``, with the cost
+counters a speed-against-error study needs. Used by the slow tests and by
+``workflows/speed_vs_error.py``.
+
+Errors are measured on the Shepard-interpolated depth field (``floodsph.sph.interpolate``),
+which is what the output maps show:
+
+* Ritter (dry-bed dam break): d0 = 10 m, dam at x = 1000 m in a 2000 m x 100 m closed channel,
+  t = 50 s; L1 relative over four lines along the channel; front = last x with d > 0.1 m.
+* Stoker (wet-bed dam break): 10 m / 2 m, same channel and time; the bore position is where
+  the depth crosses the mean of the middle and downstream depths.
+* Thacker (planar surface in a paraboloid): h0 = 10 m, a = 3000 m, eta = 1500 m, one period;
+  L1 relative over the exact wet disc on a 50 m grid.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from floodsph import testing as exact
+from floodsph.constants import RHO_WATER
+from floodsph.model import FloodModel, Numerics
+from floodsph.particles import ParticleSet
+from floodsph.sph.interpolate import sample_field
+from floodsph.terrain import Terrain
+
+
+@dataclass
+class CaseResult:
+    case: str
+    spacing: float
+    particles: int
+    steps: int
+    wall_s: float
+    particle_steps: int
+    interactions: int
+    l1: float
+    front_error_m: float
+    mass_error_rel: float
+
+    @property
+    def particle_steps_per_s(self) -> float:
+        return self.particle_steps / self.wall_s
+
+    @property
+    def interactions_per_s(self) -> float:
+        return self.interactions / self.wall_s
+
+
+def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **numerics):
+    terrain = Terrain.from_function(bed, xlim, ylim, cell)
+    X, Y = np.meshgrid(np.arange(dx / 2, terrain.width, dx), np.arange(dx / 2, terrain.height, dx))
+    x, y = X.ravel(), Y.ravel()
+    d = depth(x + terrain.x0, y + terrain.y0)
+    wet = d > 1e-3
+    p = ParticleSet(int(wet.sum()))
+    p.append(x=x[wet], y=y[wet], m=RHO_WATER * d[wet] * dx * dx, rho=RHO_WATER * d[wet],
+             h=np.full(int(wet.sum()), kappa * dx),
+             u=np.broadcast_to(u(x + terrain.x0, y + terrain.y0), x.shape)[wet] if callable(u)
+             else u,
+             v=np.broadcast_to(v(x + terrain.x0, y + terrain.y0), x.shape)[wet] if callable(v)
+             else v)
+    return FloodModel(terrain, p, Numerics(spacing=dx, kappa=kappa, **numerics))
+
+
+def _run(model, t_end):
+    """Run to t_end; return (wall seconds, particle-steps, neighbour interactions)."""
+    pst = 0
+    pairs = 0
+    t0 = time.perf_counter()
+    while model.t < t_end - 1e-9:
+        pst += model.particles.n
+        pairs += model.nl.count()
+        model.step(t_end - model.t)
+    return time.perf_counter() - t0, pst, pairs
+
+
+def _channel_profile(model, xq):
+    ys = np.array([12.5, 37.5, 62.5, 87.5])
+    X, Y = np.meshgrid(xq, ys)
+    return sample_field(model, X.ravel(), Y.ravel())[:, 0].reshape(X.shape).mean(axis=0)
+
+
+def ritter(dx: float, kappa: float = 1.3, **numerics) -> CaseResult:
+    """Dry-bed dam break (Ritter), d0 = 10 m, t = 50 s."""
+    d0, t_end = 10.0, 50.0
+    model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
+                           lambda x, y: np.where(x < 1000, d0, 0.0), dx, kappa, **numerics)
+    v0 = model.volume()
+    wall, pst, pairs = _run(model, t_end)
+    xq = np.arange(0.5, 2000, 1.0)
+    d = _channel_profile(model, xq)
+    d_ex, _ = exact.ritter(xq, t_end, d0, x_dam=1000.0)
+    front = exact.front_position(xq, d, 0.1) - exact.front_position(xq, d_ex, 0.1)
+    return CaseResult("ritter", dx, model.particles.n, model.steps, wall, pst, pairs,
+                      exact.l1_relative(d, d_ex), float(front),
+                      abs(model.volume() - v0) / v0)
+
+
+def stoker(dx: float, kappa: float = 1.3, **numerics) -> CaseResult:
+    """Wet-bed dam break (Stoker), 10 m over 2 m, t = 50 s."""
+    d_l, d_r, t_end = 10.0, 2.0, 50.0
+    model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
+                           lambda x, y: np.where(x < 1000, d_l, d_r), dx, kappa, **numerics)
+    v0 = model.volume()
+    wall, pst, pairs = _run(model, t_end)
+    xq = np.arange(0.5, 2000, 1.0)
+    d = _channel_profile(model, xq)
+    d_ex, _ = exact.stoker(xq, t_end, d_l, d_r, x_dam=1000.0)
+    d_m, _, _ = exact.stoker_middle_state(d_l, d_r)
+    right = xq > 1000
+    bore = xq[right][d[right] > 0.5 * (d_m + d_r)].max()
+    front = bore - exact.stoker_bore_position(t_end, d_l, d_r, x_dam=1000.0)
+    return CaseResult("stoker", dx, model.particles.n, model.steps, wall, pst, pairs,
+                      exact.l1_relative(d, d_ex), float(front),
+                      abs(model.volume() - v0) / v0)
+
+
+def thacker(dx: float, kappa: float = 1.3, periods: float = 1.0, **numerics) -> CaseResult:
+    """Thacker's planar surface in a paraboloid, frictionless, over ``periods`` periods."""
+    h0, a, eta = 10.0, 3000.0, 1500.0
+    t_end = periods * exact.thacker_period(h0, a)
+    model = _lattice_model(
+        lambda x, y: h0 * (x**2 + y**2) / a**2, (-5000, 5000), (-5000, 5000), 50.0,
+        lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[0], dx, kappa,
+        u=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[1],
+        v=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[2], **numerics)
+    v0 = model.volume()
+    wall, pst, pairs = _run(model, t_end)
+    xq = np.arange(-4975.0, 5000.0, 50.0)
+    X, Y = np.meshgrid(xq, xq)
+    d = sample_field(model, X.ravel() + 5000.0, Y.ravel() + 5000.0)[:, 0]
+    d_ex = exact.thacker_planar(X.ravel(), Y.ravel(), t_end, h0, a, eta)[0]
+    wet = d_ex > 0
+    l1 = float(np.abs(d - d_ex)[wet].sum() / d_ex[wet].sum())
+    r_wet = np.hypot(X.ravel() - eta, Y.ravel())[(d > 1e-3)]
+    shore = float(r_wet.max() - a) if r_wet.size else np.nan
+    return CaseResult("thacker", dx, model.particles.n, model.steps, wall, pst, pairs, l1,
+                      shore, abs(model.volume() - v0) / v0)
+
+
+CASES = {"ritter": ritter, "stoker": stoker, "thacker": thacker}
