@@ -121,13 +121,15 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, bxmin, bymin, bu
             b = by * nbx + bx
             for q in range(bstart[b], bstart[b + 1]):
                 s = items[q]
-                if segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]) < radius:
+                dist = segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+                if dist < radius:
                     if fill:
                         wseg[wstart[i] + k] = s
                     k += 1
         else:
             for s in range(seg.shape[0]):
-                if segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]) < radius:
+                dist = segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+                if dist < radius:
                     if fill:
                         wseg[wstart[i] + k] = s
                     k += 1
