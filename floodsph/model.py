@@ -201,7 +201,8 @@ class FloodModel:
     def _forces(self) -> None:
         p = self.particles
         t = self.terrain
-        self.bed = np.empty((p.n, 7))
+        if self.bed.shape[0] != p.n:
+            self.bed = np.empty((p.n, 7))
         bedmod.sample_bed(p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         forces.internal_acceleration(p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, self.nl.start,
                                      self.nl.nbr, self.wstart, self.wseg, self.seg, self.scheme,
