@@ -19,6 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
+from floodsph.boundaries.open_edges import OpenEdges
+from floodsph.boundaries.openings import cut_openings
 from floodsph.constants import RHO_WATER
 from floodsph.particles import ParticleSet
 from floodsph.sph import bed as bedmod
@@ -72,26 +75,45 @@ class FloodModel:
     numerics : Numerics
     walls : sequence of (k, 2) arrays
         Polylines in local coordinates that water cannot cross.
-    closed_edges : bool
+    closed_edges : bool or collection of str
         True: the DEM border and nodata areas are walls. False: water reaching them leaves the
-        model and is counted in ``volume_out``.
+        model and is counted in ``volume_out``; the open sides get transmissive ghosts
+        (``floodsph.boundaries.OpenEdges``). A collection of sides (``"west"``, ``"east"``,
+        ``"south"``, ``"north"``) closes those sides and opens the others; nodata borders
+        are then walls.
+    boundaries : sequence
+        Open boundaries (inflows, sinks): objects with ``apply(model, dt)`` called after each
+        drift; they add to ``volume_in`` / ``volume_out`` what they inject or remove, and
+        ``protected(x, y) -> bool array`` marking particles in their zone of influence.
+    refiner : object or None
+        Particle splitting and coalescing: ``apply(model) -> (splits, merges)``, called after
+        the boundaries once the particles have moved (``floodsph.refinement``).
     """
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics = Numerics(),
-                 walls=(), closed_edges: bool = True):
+                 walls=(), closed_edges: bool = True, boundaries=(), refiner=None):
         self.terrain = terrain
+        self.boundaries = list(boundaries)
+        self.refiner = refiner
         self.particles = particles
         self.numerics = numerics
-        self.closed_edges = closed_edges
         self.scheme = {"lax-friedrichs": forces.LAX_FRIEDRICHS,
                        "riemann": forces.RIEMANN}[numerics.stabilisation]
-        segs = [wallmod.segments_from_polylines(walls)]
-        if closed_edges:
-            box = wallmod.box_polyline(0.0, 0.0, terrain.width, terrain.height)
-            segs.append(wallmod.segments_from_polylines([box]))
-            segs.append(wallmod.mask_boundary_segments(terrain.valid, terrain.dx, terrain.dy))
-        self.seg = np.concatenate(segs)
+        closed = set(OPEN_SIDES) if closed_edges is True else set(closed_edges or ())
+        unknown = closed - set(OPEN_SIDES)
+        if unknown:
+            raise ValueError(f"closed_edges: unknown sides {sorted(unknown)}; use {OPEN_SIDES}")
+        self.closed_edges = closed_edges
+        open_sides = [side for side in OPEN_SIDES if side not in closed]
+        if open_sides:
+            self.boundaries.insert(0, OpenEdges(terrain.width, terrain.height, open_sides))
         h0 = numerics.kappa * numerics.spacing
+        segs = [wallmod.segments_from_polylines(walls),
+                _side_segments(terrain, closed, extension=6.0 * h0)]
+        if closed_edges is not False:
+            segs.append(wallmod.mask_boundary_segments(terrain.valid, terrain.dx, terrain.dy))
+        openings = [b.opening for b in self.boundaries if hasattr(b, "opening")]
+        self.seg = cut_openings(np.concatenate(segs), openings, 1e-6 * numerics.spacing)
         self.wall_index = wallmod.WallIndex(
             self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=8.0 * h0,
             margin=8.0 * h0)
@@ -102,10 +124,10 @@ class FloodModel:
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
                          "wall_reflections": 0, "density_unconverged": 0}
         self.bed = np.empty((0, 7))
+        for boundary in self.boundaries:
+            boundary.apply(self, 0.0)
         self._remove_outside()
-        self._neighbours()
-        self._solve_density()
-        self._forces()
+        self._interactions()
         self.dt = self.stable_dt()
 
     def __repr__(self) -> str:
@@ -122,10 +144,14 @@ class FloodModel:
         return self.particles.volume()
 
     def stable_dt(self) -> float:
+        """dt = cfl min h / (|v| + c) over the water and the open boundaries' buffers [s]."""
         p = self.particles
-        if p.n == 0:
-            return np.inf
-        return float(forces.stable_dt(p.u, p.v, p.rho, p.h, self.numerics.cfl))
+        cfl = self.numerics.cfl
+        dt = float(forces.stable_dt(p.u, p.v, p.rho, p.h, cfl)) if p.n else np.inf
+        for boundary in self.boundaries:
+            if hasattr(boundary, "max_dt"):
+                dt = min(dt, boundary.max_dt(cfl))
+        return dt
 
     # -- one step ------------------------------------------------------------------------------
     def step(self, dt_max: float | None = None) -> float:
@@ -135,23 +161,22 @@ class FloodModel:
         half = 0.5 * dt
         p.u[:] += half * p.ax
         p.v[:] += half * p.ay
-        x_old = p.x.copy()
-        y_old = p.y.copy()
-        p.x[:] += dt * p.u
-        p.y[:] += dt * p.v
-        if self.seg.shape[0]:
-            self.counters["wall_reflections"] += int(wallmod.guard_crossings(
-                x_old, y_old, p.x, p.y, p.u, p.v, self.wstart, self.wseg, self.seg))
+        self.counters["wall_reflections"] += int(wallmod.drift(
+            p.x, p.y, p.u, p.v, dt, self.wstart, self.wseg, self.seg))
+        for boundary in self.boundaries:
+            boundary.apply(self, dt)
         self._remove_outside()
         density.predict(p.rho, p.h, p.divv, dt)
+        if self.refiner is not None:
+            splits, merges = self.refiner.apply(self)
+            self.counters["splits"] += splits
+            self.counters["merges"] += merges
         if self.numerics.reorder_interval and self.steps % self.numerics.reorder_interval == 0:
             self._reorder()
-        self._neighbours()
-        self._solve_density()
-        self._forces()
+        self._interactions()
         p.u[:] += half * p.ax
         p.v[:] += half * p.ay
-        forces.apply_friction(p.u, p.v, p.rho, self.bed[:, 6], dt,
+        forces.apply_friction(p.u, p.v, p.rho, self.bed[: p.n, 6], dt,
                               self.numerics.friction_depth_floor)
         self.t += dt
         self.steps += 1
@@ -159,7 +184,36 @@ class FloodModel:
         self.dt = self.stable_dt()
         return dt
 
+    def near_wall(self) -> np.ndarray:
+        """True for particles with a wall segment within their kernel reach (needs ``nl``)."""
+        return np.diff(self.wstart) > 0
+
+    def protected(self) -> np.ndarray:
+        """True for particles near a wall or in an open boundary's zone (no merging there)."""
+        p = self.particles
+        mask = self.near_wall().copy()
+        for boundary in self.boundaries:
+            mask |= boundary.protected(p.x, p.y)
+        return mask
+
     # -- stages --------------------------------------------------------------------------------
+    def _interactions(self) -> None:
+        """Neighbours, density and forces of the water, with the boundaries' ghosts present.
+
+        The ghosts (inflow buffers, mirror images beyond open edges) are appended behind the
+        water, given the boundary state after the density solve, and dropped after the forces.
+        """
+        p = self.particles
+        water = p.mark()
+        for boundary in self.boundaries:
+            boundary.add_ghosts(self)
+        self._neighbours()
+        self._solve_density()
+        for boundary in self.boundaries:
+            boundary.impose(self)
+        self._forces()
+        p.truncate(water)
+
     def _remove_outside(self) -> None:
         """Remove (and count as outflow) particles off the grid or in nodata cells."""
         p = self.particles
@@ -181,7 +235,11 @@ class FloodModel:
             p.permute(grid.order)
 
     def _neighbours(self) -> None:
+        """Neighbour and near-wall lists, rebuilt only when the Verlet skin is used up."""
         p = self.particles
+        nl = getattr(self, "nl", None)
+        if nl is not None and nl.still_valid(p.x, p.y, p.h):
+            return
         self.nl = NeighbourList(p.x, p.y, p.h, skin=self.numerics.neighbour_skin)
         self.wstart, self.wseg = self.wall_index.near_lists(
             p.x, p.y, p.h, self.nl.start, self.nl.nbr, self.nl.reach)
@@ -193,7 +251,7 @@ class FloodModel:
             _, bad = density.solve_density(p, self.nl, self.wstart, self.wseg, self.seg,
                                            tol=num.density_tol, max_iter=num.density_max_iter,
                                            h_ratio=num.h_ratio)
-            if self.nl.still_valid(p.h):
+            if self.nl.still_valid(p.x, p.y, p.h):
                 break
             self._neighbours()
         self.counters["density_unconverged"] += bad
@@ -208,3 +266,20 @@ class FloodModel:
                                      self.nl.nbr, self.wstart, self.wseg, self.seg, self.scheme,
                                      p.ax, p.ay, p.divv)
         forces.add_bed_acceleration(p.u, p.v, self.bed, self.numerics.max_slope, p.ax, p.ay)
+
+
+def _side_segments(terrain: Terrain, closed, extension: float) -> np.ndarray:
+    """Wall segments (ns, 4) along the closed sides of the DEM rectangle.
+
+    A closed side that meets an open side runs on for ``extension`` metres beyond it, like
+    the banks of a channel that leaves the DEM: the water near that corner then sees the
+    mirror images of the outflow buffer (``OpenEdges``) too, and keeps its full depth.
+    """
+    w, h = terrain.width, terrain.height
+    e = {side: (0.0 if side in closed else extension) for side in OPEN_SIDES}
+    ends = {"south": (-e["west"], 0.0, w + e["east"], 0.0),
+            "east": (w, -e["south"], w, h + e["north"]),
+            "north": (w + e["east"], h, -e["west"], h),
+            "west": (0.0, h + e["north"], 0.0, -e["south"])}
+    return np.array([ends[side] for side in OPEN_SIDES if side in closed],
+                    dtype=np.float64).reshape(-1, 4)

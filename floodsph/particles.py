@@ -124,6 +124,14 @@ class ParticleSet:
             arr[:k] = arr[: self.n][order]
         self.n = k
 
+    def mark(self) -> tuple[int, int]:
+        """(n, next id): pass to :meth:`truncate` to drop everything appended after it."""
+        return self.n, self.next_pid
+
+    def truncate(self, mark: tuple[int, int]) -> None:
+        """Drop the particles appended since ``mark`` (the step's ghosts); ids are reused."""
+        self.n, self.next_pid = mark
+
     def volume(self) -> float:
         """Total water volume sum(m) / rho_w [m3]."""
         from floodsph.constants import RHO_WATER

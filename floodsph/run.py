@@ -100,6 +100,8 @@ def run_scenario(
     out.mkdir(parents=True, exist_ok=True)
     for name in RUN_FILES:
         (out / name).unlink(missing_ok=True)
+    for path in out.glob("breach_hydrograph_*.csv"):
+        path.unlink()
     log_handler = _attach_log(out / LOG_NAME)
     manifest = new_manifest(scenario.to_dict())
     manifest.update(
@@ -114,6 +116,7 @@ def run_scenario(
     probes = ()
     try:
         write_resolved(scenario, out / RESOLVED_NAME)
+        manifest["breach_hydrographs"] = write_inflow_hydrographs(scenario, inputs, out)
         write_manifest(out, manifest)
         log.info("run folder %s; %d particles, spacing %g m", out, inputs.particles.n,
                  inputs.spacing_m)
@@ -175,15 +178,10 @@ def set_threads(threads: int) -> int:
 
 
 def build_model(scenario: Scenario, inputs):
-    """The FloodModel of ``scenario`` from prepared inputs."""
+    """The FloodModel of ``scenario`` from prepared inputs, with its open boundaries."""
     from floodsph.model import FloodModel, Numerics
+    from floodsph.refinement import Refiner
 
-    if scenario.inflows or scenario.sinks:
-        # TODO(integration): pass inputs.hydrographs / sinks once the solver takes them.
-        kind = "inflows" if scenario.inflows else "sinks"
-        raise InputError(
-            f"{scenario.path.name}: {kind}: this solver version cannot model [[{kind}]] yet"
-        )
     num = scenario.numerics
     numerics = Numerics(
         cfl=num.cfl,
@@ -201,7 +199,48 @@ def build_model(scenario: Scenario, inputs):
         numerics,
         walls=inputs.walls,
         closed_edges=scenario.terrain.edges is Edges.CLOSED,
+        boundaries=open_boundaries(scenario, inputs, numerics),
+        refiner=Refiner.from_settings(num.refinement.value, inputs.spacing_m),
     )
+
+
+def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
+    """The ``[[inflows]]`` sections and ``[[sinks]]`` polygons as model boundaries."""
+    import numpy as np
+
+    from floodsph.boundaries import Inflow, Sink
+
+    terrain = inputs.terrain
+    source = scenario.path.name
+    out = []
+    for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,
+                                                 strict=True)):
+        line = np.column_stack(terrain.to_local(*np.asarray(inflow.line, dtype=np.float64).T))
+        out.append(Inflow(line, hydrograph, numerics.spacing, numerics.kappa, terrain,
+                          direction=inflow.direction, name=f"{source}: inflows[{i}]"))
+    reach = 4.0 * numerics.kappa * numerics.spacing
+    for sink in scenario.sinks:
+        polygon = np.column_stack(terrain.to_local(*np.asarray(sink.polygon, dtype=np.float64).T))
+        out.append(Sink(polygon, terrain, reach))
+    return out
+
+
+def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]:
+    """Write the routed hydrograph of each parametric breach (``inflows[i].breach``).
+
+    The file ``breach_hydrograph_<i>.csv`` (time_s, discharge_m3s) in the run folder is what
+    the run used, so it can be checked or reused as a ``hydrograph`` input.
+    """
+    from floodsph.hydrograph import write_hydrograph_csv
+
+    names = []
+    for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,
+                                                 strict=True)):
+        if inflow.breach is not None:
+            name = f"breach_hydrograph_{i}.csv"
+            write_hydrograph_csv(out / name, hydrograph.t, hydrograph.Q)
+            names.append(name)
+    return names
 
 
 def _simulation(scenario, inputs, model, out, max_steps, progress, extra):
@@ -241,9 +280,19 @@ def _finish_manifest(manifest: dict, model, probes, wall_time: float) -> None:
         volume_domain_m3=float(model.volume()),
         volume_in_m3=float(model.volume_in),
         volume_out_m3=float(model.volume_out),
+        inflows=[_inflow_summary(b) for b in model.boundaries if hasattr(b, "pending")],
     )
     if probes:
         manifest["mass_error_rel"] = probes[0].budget(model)[4]
+
+
+def _inflow_summary(inflow) -> dict:
+    """Injected volume of an inflow against its hydrograph up to the end of the run."""
+    return {
+        "name": inflow.name,
+        "volume_injected_m3": float(inflow.volume_in),
+        "volume_hydrograph_m3": float(inflow.hydrograph.volume(0.0, inflow.t)),
+    }
 
 
 def _attach_log(path: Path) -> tuple[logging.Handler, int]:

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 from scipy.spatial import cKDTree
+from sph_cases import model_on
 
-from floodsph.sph.kernels import SIGMA_2D, dwdr_cubic, w_cubic
+from floodsph.sph.kernels import SIGMA_2D, dwdr_over_r_cubic, w_cubic, w_dwdr_cubic
 from floodsph.sph.neighbours import NeighbourList
 
 
@@ -22,7 +23,11 @@ def test_kernel_derivative_matches_finite_difference():
     for r in np.linspace(0.05, 3.3, 40):
         e = 1e-6
         fd = (w_cubic(r + e, h) - w_cubic(r - e, h)) / (2 * e)
-        assert dwdr_cubic(r, h) == pytest.approx(fd, rel=1e-6, abs=1e-9)
+        w, dwdr = w_dwdr_cubic(r, h)
+        assert w == w_cubic(r, h)
+        assert dwdr == pytest.approx(fd, rel=1e-6, abs=1e-9)
+        assert dwdr_over_r_cubic(r, 1.0 / r, 1.0 / h) == pytest.approx(dwdr / r, rel=1e-13,
+                                                                       abs=1e-15)
 
 
 def _reference_pairs(x, y, h):
@@ -55,11 +60,70 @@ def test_neighbour_lists_equal_kdtree_with_mixed_h(cloud):
     assert _listed_pairs(nl, n) == _reference_pairs(x, y, h)
 
 
+def test_neighbour_lists_equal_kdtree_with_h_spread_over_many_levels():
+    """A front-like cloud: h grows smoothly by a factor 20 along x (five search levels)."""
+    rng = np.random.default_rng(11)
+    n = 5000
+    x, y = rng.uniform(0, 400, n), rng.uniform(0, 80, n)
+    h = 0.8 * np.exp(3.0 * x / 400) * rng.uniform(0.9, 1.1, n)
+    nl = NeighbourList(x, y, h, skin=0.0)
+    assert _listed_pairs(nl, n) == _reference_pairs(x, y, h)
+
+
 def test_skin_keeps_list_valid_until_h_grows_past_it():
     rng = np.random.default_rng(3)
     x, y = rng.uniform(0, 50, 2000), rng.uniform(0, 50, 2000)
     h = np.full(2000, 1.0)
     nl = NeighbourList(x, y, h, skin=0.1)
-    assert nl.still_valid(h * 1.09)
-    assert not nl.still_valid(h * 1.11)
+    assert nl.still_valid(x, y, h * 1.09)
+    assert not nl.still_valid(x, y, h * 1.11)
     assert _reference_pairs(x, y, h * 1.1) <= _listed_pairs(nl, 2000)
+
+
+def test_verlet_list_stays_exact_while_particles_move_within_the_skin():
+    """Moves of up to D h_b and growth of h up to G h_b with G + D = 1 + skin lose no pair."""
+    rng = np.random.default_rng(5)
+    n = 3000
+    x, y = rng.uniform(0, 60, n), rng.uniform(0, 60, n)
+    h = rng.uniform(0.8, 1.6, n)
+    skin = 0.3
+    nl = NeighbourList(x, y, h, skin=skin)
+    move, grow = 0.12, 1.0 + skin - 0.12
+    angle = rng.uniform(0, 2 * np.pi, n)
+    x1 = x + move * h * np.cos(angle) * 0.999
+    y1 = y + move * h * np.sin(angle) * 0.999
+    h1 = h * grow
+    assert nl.still_valid(x1, y1, h1)
+    assert _reference_pairs(x1, y1, h1) <= _listed_pairs(nl, n)
+    assert not nl.still_valid(x1 + 0.2 * h, y1, h1)
+    assert not nl.still_valid(x1[:-1], y1[:-1], h1[:-1])  # a particle removed
+
+
+def test_verlet_lists_kept_over_steps_give_the_flow_of_lists_rebuilt_every_step():
+    """Dam break against a building (walls, corners, near-wall lists): a wide skin keeps the
+    lists over several steps, and the flow is that of lists rebuilt at every step (to
+    round-off: the density is solved tightly, so the Newton path does not matter)."""
+    building = np.array([[220.0, 70.0], [280.0, 70.0], [280.0, 130.0], [220.0, 130.0],
+                         [220.0, 70.0]])
+
+    def depth(x, y):
+        return np.where(x < 150.0, 4.0, 0.0)
+
+    states, lists = [], []
+    for skin in (0.1, 0.6):
+        model = model_on(lambda x, y: 0 * x, (0, 400), (0, 200), 10.0, depth, 10.0,
+                         walls=[building], neighbour_skin=skin, density_tol=1e-12)
+        built, last = 0, None
+        while model.t < 30.0:
+            model.step()
+            built += model.nl is not last
+            last = model.nl
+        p = model.particles
+        order = np.argsort(p.pid)
+        states.append(np.c_[p.x, p.y, p.u, p.v, p.rho][order])
+        lists.append((built, model.steps))
+    (rebuilt, steps), (kept, steps_kept) = lists
+    assert rebuilt == steps and steps_kept == steps
+    assert kept < steps / 2
+    assert states[0][:, 0].max() > 280.0  # the front has passed the building
+    np.testing.assert_allclose(states[1], states[0], rtol=1e-8, atol=1e-8)

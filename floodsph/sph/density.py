@@ -25,97 +25,119 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from floodsph.sph.kernels import dwdr_cubic, w_cubic
+from floodsph.sph.kernels import w_cubic, w_dwdr_cubic
 from floodsph.sph.walls import blocked, corner_image, wall_image
 
 
 @njit(inline="always", cache=True)
-def _add_pair(rx, ry, mj, hi, acc):
+def _pair(rx, ry, mj, hi):
+    """m_j W(r, h_i) and m_j r dW/dr(r, h_i) of a pair at separation (rx, ry)."""
     r = math.sqrt(rx * rx + ry * ry)
-    acc[0] += mj * w_cubic(r, hi)
-    acc[1] -= mj * r * dwdr_cubic(r, hi)
+    w, dw = w_dwdr_cubic(r, hi)
+    return mj * w, mj * r * dw
 
 
-@njit(parallel=True, cache=True)
-def summation(idx, x, y, m, h, nstart, nbr, wstart, wseg, seg, out_sum, out_alpha):
-    """Density summation (1) and alpha at the particles listed in ``idx``, at their current h.
+@njit(inline="always", cache=True)
+def _image(i, j, x, y, m, hi, seg, s):
+    xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
+    if not ok:
+        return 0.0, 0.0
+    return _pair(x[i] - xm, y[i] - ym, m[j], hi)
 
-    Writes out_sum[i] = sum_j m_j W(r_ij, h_i) and out_alpha[i] for i in idx.
+
+@njit(inline="always", cache=True)
+def _corner(i, j, x, y, m, hi, seg, s1, s2):
+    xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
+    if not ok:
+        return 0.0, 0.0
+    return _pair(x[i] - xc, y[i] - yc, m[j], hi)
+
+
+@njit(inline="always", cache=True)
+def summation(i, hi, x, y, m, nstart, nbr, wstart, wseg, seg):
+    """Density summation (1) and alpha_i of particle i at smoothing length ``hi``.
+
+    Returns (sum_j m_j W(r_ij, h_i), alpha_i), self and mirror images included; listed
+    neighbours beyond the support 2 h_i are skipped (W = 0 there).
     """
-    for k in prange(idx.shape[0]):
-        i = idx[k]
-        xi = x[i]
-        yi = y[i]
-        hi = h[i]
-        acc = np.zeros(2)
-        acc[0] = m[i] * w_cubic(0.0, hi)
+    xi = x[i]
+    yi = y[i]
+    rsum = m[i] * w_cubic(0.0, hi)
+    alpha = 0.0
+    near_wall = wstart[i + 1] > wstart[i]
+    support2 = 4.0 * hi * hi
+    for q in range(nstart[i], nstart[i + 1]):
+        j = nbr[q]
+        rx = xi - x[j]
+        ry = yi - y[j]
+        if rx * rx + ry * ry >= support2:
+            continue
+        if near_wall and blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
+            continue
+        w, a = _pair(rx, ry, m[j], hi)
+        rsum += w
+        alpha -= a
+    for k in range(wstart[i], wstart[i + 1]):
+        s = wseg[k]
+        w, a = _image(i, i, x, y, m, hi, seg, s)
+        rsum += w
+        alpha -= a
         for q in range(nstart[i], nstart[i + 1]):
             j = nbr[q]
-            if wstart[i + 1] > wstart[i] and blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
+            if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
                 continue
-            _add_pair(xi - x[j], yi - y[j], m[j], hi, acc)
-        for w in range(wstart[i], wstart[i + 1]):
-            s = wseg[w]
-            _add_image(i, i, x, y, m, hi, seg, s, acc)
+            w, a = _image(i, j, x, y, m, hi, seg, s)
+            rsum += w
+            alpha -= a
+        for k2 in range(k + 1, wstart[i + 1]):
+            s2 = wseg[k2]
+            w, a = _corner(i, i, x, y, m, hi, seg, s, s2)
+            rsum += w
+            alpha -= a
             for q in range(nstart[i], nstart[i + 1]):
                 j = nbr[q]
                 if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
                     continue
-                _add_image(i, j, x, y, m, hi, seg, s, acc)
-            for w2 in range(w + 1, wstart[i + 1]):
-                s2 = wseg[w2]
-                _add_corner(i, i, x, y, m, hi, seg, s, s2, acc)
-                for q in range(nstart[i], nstart[i + 1]):
-                    j = nbr[q]
-                    if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
-                        continue
-                    _add_corner(i, j, x, y, m, hi, seg, s, s2, acc)
-        out_sum[i] = acc[0]
-        out_alpha[i] = acc[1]
-
-
-@njit(inline="always", cache=True)
-def _add_image(i, j, x, y, m, hi, seg, s, acc):
-    xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
-    if ok:
-        _add_pair(x[i] - xm, y[i] - ym, m[j], hi, acc)
-
-
-@njit(inline="always", cache=True)
-def _add_corner(i, j, x, y, m, hi, seg, s1, s2, acc):
-    xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
-    if ok:
-        _add_pair(x[i] - xc, y[i] - yc, m[j], hi, acc)
+                w, a = _corner(i, j, x, y, m, hi, seg, s, s2)
+                rsum += w
+                alpha -= a
+    return rsum, alpha
 
 
 @njit(parallel=True, cache=True)
-def newton_update(idx, rho, h, h0, rho0, s, alpha, tol, h_ratio, converged):
-    """One Newton step (3) for the particles in ``idx``; flags converged ones.
+def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, wstart, wseg, seg, tol, max_iter,
+          h_ratio, iters):
+    """Newton-Raphson solve (1)-(3) of every particle, in place (gather form).
 
-    ``s`` and ``alpha`` are the summation and correction term at the current (rho, h).
-    A particle already within ``tol`` keeps its (rho, h) and is flagged converged.
+    Only h_i changes the summation of particle i, so each particle iterates on its own to
+    convergence. ``iters[i]`` receives the number of summations of particle i, negated when
+    it did not converge in ``max_iter`` (it then takes the plain summation at its h).
+    A particle already within ``tol`` keeps its (rho, h); alpha is that of the last summation.
     """
-    for k in prange(idx.shape[0]):
-        i = idx[k]
-        res = rho[i] - s[i]
-        if abs(res) < tol * rho[i]:
-            converged[i] = True
-            continue
-        new = rho[i] * (1.0 - 2.0 * res / (2.0 * res + alpha[i]))
-        if not (new > 0.0) or not math.isfinite(new) or alpha[i] <= 0.0:
-            new = s[i]
-        h_new = h0[i] * math.sqrt(rho0[i] / new)
-        h_new = min(max(h_new, h0[i] / h_ratio), h0[i] * h_ratio)
-        rho[i] = new
-        h[i] = h_new
-
-
-@njit(parallel=True, cache=True)
-def fallback(idx, rho, s):
-    """Unconverged particles take the plain summation at their current h."""
-    for k in prange(idx.shape[0]):
-        i = idx[k]
-        rho[i] = s[i]
+    for i in prange(x.shape[0]):
+        it = 0
+        done = False
+        while it < max_iter:
+            s, a = summation(i, h[i], x, y, m, nstart, nbr, wstart, wseg, seg)
+            alpha[i] = a
+            it += 1
+            res = rho[i] - s
+            if abs(res) < tol * rho[i]:
+                done = True
+                break
+            new = rho[i] * (1.0 - 2.0 * res / (2.0 * res + alpha[i]))
+            if not (new > 0.0) or not math.isfinite(new) or alpha[i] <= 0.0:
+                new = s
+            h_new = h0[i] * math.sqrt(rho0[i] / new)
+            rho[i] = new
+            h[i] = min(max(h_new, h0[i] / h_ratio), h0[i] * h_ratio)
+        if done:
+            iters[i] = it
+        else:
+            s, a = summation(i, h[i], x, y, m, nstart, nbr, wstart, wseg, seg)
+            rho[i] = s
+            alpha[i] = a
+            iters[i] = -it
 
 
 @njit(parallel=True, cache=True)
@@ -127,25 +149,15 @@ def predict(rho, h, divv, dt):
         h[i] *= 1.0 / math.sqrt(f)
 
 
-def solve_density(p, nl, wstart, wseg, seg, tol=1e-3, max_iter=20, h_ratio=10.0, scratch=None):
+def solve_density(p, nl, wstart, wseg, seg, tol=1e-3, max_iter=20, h_ratio=10.0):
     """Solve (1)-(3) for all particles of ``p`` in place; return (iterations, unconverged).
 
     ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList.
     On return every particle has rho, h and alpha consistent with its neighbours to ``tol``,
     except the returned number of unconverged ones, which take the plain summation.
+    ``iterations`` is the largest number of summations any particle needed.
     """
-    n = p.n
-    s = np.empty(n) if scratch is None else scratch[0][:n]
-    alpha = p.alpha
-    converged = np.zeros(n, dtype=np.bool_)
-    idx = np.arange(n, dtype=np.int64)
-    iters = 0
-    while idx.size and iters < max_iter:
-        summation(idx, p.x, p.y, p.m, p.h, nl.start, nl.nbr, wstart, wseg, seg, s, alpha)
-        newton_update(idx, p.rho, p.h, p.h0, p.rho0, s, alpha, tol, h_ratio, converged)
-        idx = idx[~converged[idx]]
-        iters += 1
-    if idx.size:
-        summation(idx, p.x, p.y, p.m, p.h, nl.start, nl.nbr, wstart, wseg, seg, s, alpha)
-        fallback(idx, p.rho, s)
-    return iters, int(idx.size)
+    iters = np.zeros(p.n, dtype=np.int64)
+    solve(p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, wstart, wseg, seg,
+          tol, max_iter, h_ratio, iters)
+    return int(np.abs(iters).max(initial=0)), int((iters < 0).sum())

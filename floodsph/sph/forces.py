@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.sph.kernels import dwdr_cubic
+from floodsph.sph.kernels import dwdr_over_r_cubic
 from floodsph.sph.walls import blocked, corner_image, mirror, wall_image
 
 LAX_FRIEDRICHS = 0
@@ -61,95 +61,136 @@ def riemann_pressure(d_l, d_r, u_l, u_r):
     return 0.5 * GRAVITY * RHO_WATER * d_star * d_star
 
 
+@njit(parallel=True, cache=True)
+def pair_coefficients(rho, alpha, h, coef):
+    """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i).
+
+    beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
+    1 / h_i [m^-1].
+    """
+    for i in prange(rho.shape[0]):
+        coef[i, 0] = 2.0 * rho[i] / alpha[i]
+        coef[i, 1] = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
+        coef[i, 2] = 1.0 / h[i]
+
+
 @njit(inline="always", cache=True)
-def pair_force(rx, ry, vx, vy, mj, rho_i, rho_j, alpha_i, alpha_j, h_i, h_j, scheme, acc):
-    """Add the pair term of a_i^int and of div v_i for separation r = x_i - x_j, v = v_i - v_j."""
-    r = math.sqrt(rx * rx + ry * ry)
-    if r <= 0.0:
-        return
-    beta_i = 2.0 * rho_i / alpha_i
-    beta_j = 2.0 * rho_j / alpha_j
-    fi = dwdr_cubic(r, h_i) / r
-    fj = dwdr_cubic(r, h_j) / r
+def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme):
+    """Pair terms of a_i^int and of div v_i for separation r = x_i - x_j, v = v_i - v_j.
+
+    j's properties (mass, density, h, ``coef`` of :func:`pair_coefficients`) are taken at
+    index j, also for j's mirror images (whose r and v the caller passes). Returns
+    (fx, fy, fd): the caller subtracts them from a_i^int (x, y) and from the divergence sum
+    sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i).
+    """
+    r2 = rx * rx + ry * ry
+    if r2 <= 0.0:
+        return 0.0, 0.0, 0.0
+    r = math.sqrt(r2)
+    inv_r = 1.0 / r
+    fi = dwdr_over_r_cubic(r, inv_r, coef[i, 2])
+    fj = dwdr_over_r_cubic(r, inv_r, coef[j, 2])
     vr = vx * rx + vy * ry
     if scheme == RIEMANN:
-        d_i = rho_i / RHO_WATER
-        d_j = rho_j / RHO_WATER
         # axis from i to j: u_l = v_i . e, u_r = v_j . e, so u_l - u_r = -vr / r
-        p_star = riemann_pressure(d_i, d_j, 0.0, vr / r)
-        ci = p_star * beta_i / (rho_i * rho_i)
-        cj = p_star * beta_j / (rho_j * rho_j)
+        p_star = riemann_pressure(rho[i] / RHO_WATER, rho[j] / RHO_WATER, 0.0, vr * inv_r)
+        ci = p_star * coef[i, 0] / (rho[i] * rho[i])
+        cj = p_star * coef[j, 0] / (rho[j] * rho[j])
     else:
+        # Pi_ij for approaching pairs, computed for all and zero otherwise (no jump)
+        hbar = 0.5 * (h[i] + h[j])
+        cbar = 0.5 * (coef[i, 1] + coef[j, 1])
+        pi_ij = -cbar * min(vr, 0.0) / (0.5 * (rho[i] + rho[j])
+                                        * math.sqrt(r2 + 0.01 * hbar * hbar))
         k = 0.5 * GRAVITY / RHO_WATER
-        ci = k * beta_i
-        cj = k * beta_j
-        if vr < 0.0:
-            hbar = 0.5 * (h_i + h_j)
-            cbar = 0.5 * (math.sqrt(GRAVITY * rho_i / RHO_WATER)
-                          + math.sqrt(GRAVITY * rho_j / RHO_WATER))
-            pi_ij = -cbar * vr / (0.5 * (rho_i + rho_j) * math.sqrt(r * r + 0.01 * hbar * hbar))
-            ci += 0.5 * pi_ij
-            cj += 0.5 * pi_ij
-    f = mj * (ci * fi + cj * fj)
-    acc[0] -= f * rx
-    acc[1] -= f * ry
-    acc[2] -= mj * fi * vr
+        ci = k * coef[i, 0] + 0.5 * pi_ij
+        cj = k * coef[j, 0] + 0.5 * pi_ij
+    f = m[j] * (ci * fi + cj * fj)
+    return f * rx, f * ry, m[j] * fi * vr
 
 
 @njit(parallel=True, cache=True)
 def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, wstart, wseg, seg, scheme,
                           ax, ay, divv):
-    """a^int and div v of every particle (gather form), mirror images included."""
+    """a^int and div v of every particle (gather form), mirror images included.
+
+    Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there).
+    """
+    coef = np.empty((x.shape[0], 3))
+    pair_coefficients(rho, alpha, h, coef)
     for i in prange(x.shape[0]):
         xi = x[i]
         yi = y[i]
-        acc = np.zeros(3)
+        hi = h[i]
+        fx = 0.0
+        fy = 0.0
+        fd = 0.0
         near_wall = wstart[i + 1] > wstart[i]
         for q in range(nstart[i], nstart[i + 1]):
             j = nbr[q]
+            rx = xi - x[j]
+            ry = yi - y[j]
+            hm = 2.0 * max(hi, h[j])
+            if rx * rx + ry * ry >= hm * hm:
+                continue
             if near_wall and blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
                 continue
-            pair_force(xi - x[j], yi - y[j], u[i] - u[j], v[i] - v[j], m[j], rho[i], rho[j],
-                       alpha[i], alpha[j], h[i], h[j], scheme, acc)
+            gx, gy, gd = pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m, rho, h, coef,
+                                    scheme)
+            fx -= gx
+            fy -= gy
+            fd -= gd
         for w in range(wstart[i], wstart[i + 1]):
             s = wseg[w]
-            _image_force(i, i, x, y, u, v, m, rho, alpha, h, seg, s, scheme, acc)
+            gx, gy, gd = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
+            fx -= gx
+            fy -= gy
+            fd -= gd
             for q in range(nstart[i], nstart[i + 1]):
                 j = nbr[q]
                 if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
                     continue
-                _image_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s, scheme, acc)
+                gx, gy, gd = _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme)
+                fx -= gx
+                fy -= gy
+                fd -= gd
             for w2 in range(w + 1, wstart[i + 1]):
                 s2 = wseg[w2]
-                _corner_force(i, i, x, y, u, v, m, rho, alpha, h, seg, s, s2, scheme, acc)
+                gx, gy, gd = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
+                fx -= gx
+                fy -= gy
+                fd -= gd
                 for q in range(nstart[i], nstart[i + 1]):
                     j = nbr[q]
                     if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
                         continue
-                    _corner_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s, s2, scheme, acc)
-        ax[i] = acc[0]
-        ay[i] = acc[1]
-        divv[i] = 2.0 * acc[2] / alpha[i]
+                    gx, gy, gd = _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, s2,
+                                               scheme)
+                    fx -= gx
+                    fy -= gy
+                    fd -= gd
+        ax[i] = fx
+        ay[i] = fy
+        divv[i] = 2.0 * fd / alpha[i]
 
 
 @njit(inline="always", cache=True)
-def _image_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s, scheme, acc):
+def _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme):
     xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
     if not ok:
-        return
+        return 0.0, 0.0, 0.0
     _, _, _, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
     vn = u[j] * nx + v[j] * ny
     um = u[j] - 2.0 * vn * nx
     vm = v[j] - 2.0 * vn * ny
-    pair_force(x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, m[j], rho[i], rho[j], alpha[i],
-               alpha[j], h[i], h[j], scheme, acc)
+    return pair_force(x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, i, j, m, rho, h, coef, scheme)
 
 
 @njit(inline="always", cache=True)
-def _corner_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s1, s2, scheme, acc):
+def _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s1, s2, scheme):
     xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
     if not ok:
-        return
+        return 0.0, 0.0, 0.0
     # two reflections of the velocity: about s1's normal, then s2's
     _, _, _, n1x, n1y = mirror(x[j], y[j], seg[s1, 0], seg[s1, 1], seg[s1, 2], seg[s1, 3])
     _, _, _, n2x, n2y = mirror(x[j], y[j], seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
@@ -159,8 +200,7 @@ def _corner_force(i, j, x, y, u, v, m, rho, alpha, h, seg, s1, s2, scheme, acc):
     vn = um * n2x + vm * n2y
     um -= 2.0 * vn * n2x
     vm -= 2.0 * vn * n2y
-    pair_force(x[i] - xc, y[i] - yc, u[i] - um, v[i] - vm, m[j], rho[i], rho[j], alpha[i],
-               alpha[j], h[i], h[j], scheme, acc)
+    return pair_force(x[i] - xc, y[i] - yc, u[i] - um, v[i] - vm, i, j, m, rho, h, coef, scheme)
 
 
 @njit(parallel=True, cache=True)

@@ -9,7 +9,12 @@ With q = r/h and sigma = 10 / (7 pi h^2) (normalised so that the integral over t
     dW/dr   = sigma / h (-3 q + 2.25 q^2)         0 <= q <= 1
             = -sigma / h 0.75 (2 - q)^2          1 <  q <= 2
 
-Units: W [m^-2], dW/dr [m^-3]. Support radius 2h.
+For the pressure force, (dW/dr) / r is evaluated from r, 1/r and 1/h without divisions:
+
+    (dW/dr) / r = sigma / h^4 (-3 + 2.25 q)          0 <= q <= 1
+                = -sigma / h^3 0.75 (2 - q)^2 / r    1 <  q <= 2
+
+Units: W [m^-2], dW/dr [m^-3], (dW/dr) / r [m^-4]. Support radius 2h.
 
 Reference: Monaghan & Lattanzio (1985); the 2-D normalisation 10/(7 pi h^2) as used by
 Vacondio et al., Adv. Water Resour. 58 (2013) 10-23 (method notes, section 1.3).
@@ -39,13 +44,28 @@ def w_cubic(r, h):
 
 
 @njit(inline="always", cache=True)
-def dwdr_cubic(r, h):
-    """Radial derivative dW/dr (r, h) [m^-3] of the 2-D cubic spline (<= 0)."""
+def w_dwdr_cubic(r, h):
+    """W(r, h) [m^-2] and dW/dr (r, h) [m^-3] of the 2-D cubic spline in one evaluation.
+
+    Both branches are evaluated and one selected (no data-dependent jump in pair loops).
+    """
     q = r / h
-    s = SIGMA_2D / (h * h * h)
-    if q <= 1.0:
-        return s * (-3.0 * q + 2.25 * q * q)
-    if q <= 2.0:
-        t = 2.0 - q
-        return -s * 0.75 * t * t
-    return 0.0
+    s = SIGMA_2D / (h * h)
+    s3 = SIGMA_2D / (h * h * h)
+    t = max(2.0 - q, 0.0)
+    inner = q <= 1.0
+    w = s * (1.0 - 1.5 * q * q + 0.75 * q * q * q) if inner else s * 0.25 * t * t * t
+    dw = s3 * (-3.0 * q + 2.25 * q * q) if inner else -s3 * 0.75 * t * t
+    return w, dw
+
+
+@njit(inline="always", cache=True)
+def dwdr_over_r_cubic(r, inv_r, inv_h):
+    """(dW/dr) / r [m^-4] of the 2-D cubic spline from r [m], 1/r and 1/h [m^-1] (<= 0).
+
+    Both branches are evaluated and one selected (no data-dependent jump in pair loops).
+    """
+    q = r * inv_h
+    s = SIGMA_2D * inv_h * inv_h * inv_h
+    t = max(2.0 - q, 0.0)
+    return s * inv_h * (-3.0 + 2.25 * q) if q <= 1.0 else -s * 0.75 * t * t * inv_r

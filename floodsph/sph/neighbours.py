@@ -2,14 +2,20 @@
 
 A pair (i, j) interacts when r_ij < 2 max(h_i, h_j) (support 2h of the cubic spline, taken
 symmetrically so that the pressure force of Vacondio et al. 2013 eq. (4) is antisymmetric).
-With smoothing lengths that differ by orders of magnitude (thin flood fronts), a cell size set
-by the largest h would put thousands of candidates in every stencil. The cell size is
-therefore set by a cut-off ``h_cut`` near the bulk of the particles; the few "big" particles
-with h > h_cut search as many rings of cells as their support needs and are found by the
-others through an explicit list, so the result is exact for any mix of h.
+Smoothing lengths can differ by orders of magnitude (thin flood fronts), and a cell size set
+by the largest h would put hundreds of candidates in every stencil. The particles are
+therefore binned by h into levels: level 0 holds h <= LEVEL_BASE median(h), level L >= 1
+holds h in (h_c 2^(L-1), h_c 2^L] with h_c = LEVEL_BASE median(h). Each level has its own
+grid over its particles' bounding box, with cells the reach R_L of its largest h, and a
+particle searches the 3 x 3 cells around it on every level within its reach (more rings
+where its own h is larger); the candidates of a row of cells are contiguous in cell order.
+The result is exact for any mix of h at a cost set by the local particle density.
 
-The list is built with a relative ``skin`` so that it stays valid while the Newton-Raphson
-density solve changes h a little (Verlet-list practice).
+The lists are Verlet lists (Verlet 1967; Allen & Tildesley, Computer Simulation of Liquids,
+2nd ed. 2017, section 5.3): built with the relative ``skin`` on the reach,
+R = 2 (1 + skin) max(h_i, h_j), they stay exact while particles move and h grows a little
+(:meth:`NeighbourList.still_valid`), so one list serves the Newton-Raphson density solve and,
+in slow flow, several time steps.
 """
 
 from __future__ import annotations
@@ -19,6 +25,9 @@ import math
 import numba as nb
 import numpy as np
 from numba import njit, prange
+
+LEVEL_BASE = 1.25
+"""Level 0 of the search holds the particles with h <= LEVEL_BASE median(h)."""
 
 
 @njit(parallel=True, cache=True)
@@ -62,6 +71,11 @@ def counting_sort(cid, ncells, nchunk):
     return cell_start, order
 
 
+def _chunks(n: int) -> int:
+    """Chunks of the parallel counting sort: one per thread, at least 4096 points each."""
+    return max(1, min(nb.get_num_threads(), n // 4096 + 1))
+
+
 class CellGrid:
     """A uniform grid of square cells over a bounding box, with points binned into it."""
 
@@ -75,101 +89,214 @@ class CellGrid:
         self.ncy = max(1, int(math.floor((ymax - ymin) / cell)) + 1)
         cid = np.empty(x.shape[0], dtype=np.int64)
         cell_ids(x, y, self.xmin, self.ymin, self.cell, self.ncx, self.ncy, cid)
-        nchunk = max(1, min(nb.get_num_threads(), x.shape[0] // 4096 + 1))
-        self.cell_start, self.order = counting_sort(cid, self.ncx * self.ncy, nchunk)
+        self.cell_start, self.order = counting_sort(cid, self.ncx * self.ncy, _chunks(x.shape[0]))
 
     def arrays(self):
         """(cell_start, order, xmin, ymin, cell, ncx, ncy) as kernels take them."""
         return self.cell_start, self.order, self.xmin, self.ymin, self.cell, self.ncx, self.ncy
 
 
-@njit(inline="always")
-def _in_range(dx, dy, hi, hj, reach):
-    r2 = dx * dx + dy * dy
-    s = reach * max(hi, hj)
-    return r2 < s * s
+@njit(cache=True)
+def _levels(x, y, h, h_c, level):
+    """Search level of every particle into ``level``.
+
+    Returns (hmax, box): the largest h of each level and its particles' bounding box
+    (x0, y0, x1, y1); an empty level has hmax 0.
+    """
+    hmax = np.zeros(64)
+    box = np.empty((64, 4))
+    box[:, :2] = np.inf
+    box[:, 2:] = -np.inf
+    top = 0
+    for i in range(h.shape[0]):
+        lv = 0
+        if h[i] > h_c:
+            lv = min(int(math.ceil(math.log2(h[i] / h_c))), 63)
+        level[i] = lv
+        hmax[lv] = max(hmax[lv], h[i])
+        box[lv, 0] = min(box[lv, 0], x[i])
+        box[lv, 1] = min(box[lv, 1], y[i])
+        box[lv, 2] = max(box[lv, 2], x[i])
+        box[lv, 3] = max(box[lv, 3], y[i])
+        top = max(top, lv)
+    return hmax[: top + 1], box[: top + 1]
 
 
 @njit(parallel=True, cache=True)
-def _scan(x, y, h, big, big_idx, cell_start, order, xmin, ymin, cell, ncx, ncy, reach,
-          h_cut, nbr_start, nbr, fill):
-    """Count (fill=False) or write (fill=True) the neighbours of every particle."""
-    n = x.shape[0]
-    for i in prange(n):
-        xi = x[i]
-        yi = y[i]
-        hi = h[i]
-        k = 0
-        pos = nbr_start[i]
-        rings = int(math.ceil(reach * max(hi, h_cut) / cell))
-        cx = min(max(int((xi - xmin) / cell), 0), ncx - 1)
-        cy = min(max(int((yi - ymin) / cell), 0), ncy - 1)
-        for gy in range(max(cy - rings, 0), min(cy + rings + 1, ncy)):
-            for gx in range(max(cx - rings, 0), min(cx + rings + 1, ncx)):
-                c = gy * ncx + gx
-                for s in range(cell_start[c], cell_start[c + 1]):
-                    j = order[s]
-                    if j == i or big[j]:
-                        continue
-                    if _in_range(x[j] - xi, y[j] - yi, hi, h[j], reach):
-                        if fill:
-                            nbr[pos + k] = j
-                        k += 1
-        for s in range(big_idx.shape[0]):
-            j = big_idx[s]
-            if j == i:
-                continue
-            if _in_range(x[j] - xi, y[j] - yi, hi, h[j], reach):
+def _level_cell_ids(x, y, level, box, lv_cell, lv_ncx, lv_ncy, lv_off, out):
+    """Cell index ``off_L + cy * ncx_L + cx`` of every point on its level's grid."""
+    for i in prange(x.shape[0]):
+        lv = level[i]
+        cx = min(max(int((x[i] - box[lv, 0]) / lv_cell[lv]), 0), lv_ncx[lv] - 1)
+        cy = min(max(int((y[i] - box[lv, 1]) / lv_cell[lv]), 0), lv_ncy[lv] - 1)
+        out[i] = lv_off[lv] + cy * lv_ncx[lv] + cx
+
+
+@njit(inline="always", cache=True)
+def _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
+            lv_hmax, reach, buf, fill):
+    """Neighbours of particle i, itself included: their number and, if ``fill``, their
+    indices in ``buf[:number]`` (``buf`` holds one slot more than the number).
+
+    ``xs, ys, hs`` are x, y, h in cell order (``xs[s] = x[order[s]]``): the candidates of a
+    row of adjacent cells are one contiguous run. Each candidate is written unconditionally
+    and kept by advancing the count, so the loop has no data-dependent jump.
+    """
+    xi = x[i]
+    yi = y[i]
+    hi = h[i]
+    k = 0
+    for lv in range(lv_cell.shape[0]):
+        cell = lv_cell[lv]
+        rad = reach * max(hi, lv_hmax[lv])
+        bx = max(box[lv, 0] - xi, xi - box[lv, 2], 0.0)
+        by = max(box[lv, 1] - yi, yi - box[lv, 3], 0.0)
+        if cell <= 0.0 or bx * bx + by * by >= rad * rad:
+            continue
+        ncx = lv_ncx[lv]
+        ncy = lv_ncy[lv]
+        rings = int(math.ceil(rad / cell))
+        cx = min(max(int((xi - box[lv, 0]) / cell), 0), ncx - 1)
+        cy = min(max(int((yi - box[lv, 1]) / cell), 0), ncy - 1)
+        cx0 = max(cx - rings, 0)
+        cx1 = min(cx + rings, ncx - 1)
+        for gy in range(max(cy - rings, 0), min(cy + rings, ncy - 1) + 1):
+            row = lv_off[lv] + gy * ncx
+            for s in range(cell_start[row + cx0], cell_start[row + cx1 + 1]):
+                dx = xs[s] - xi
+                dy = ys[s] - yi
+                r = reach * max(hi, hs[s])
                 if fill:
-                    nbr[pos + k] = j
-                k += 1
-        if not fill:
-            nbr_start[i + 1] = k
+                    buf[k] = order[s]
+                k += dx * dx + dy * dy < r * r
+    return k
+
+
+@njit(parallel=True, cache=True)
+def _count(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
+           lv_hmax, reach, nbr_start):
+    """Number of neighbours of every particle (itself excluded) into ``nbr_start[1:]``."""
+    buf = np.zeros(0, dtype=np.int64)
+    for i in prange(x.shape[0]):
+        nbr_start[i + 1] = _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell,
+                                   lv_ncx, lv_ncy, lv_off, lv_hmax, reach, buf, False) - 1
+
+
+@njit(parallel=True, cache=True)
+def _fill(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
+          lv_hmax, reach, nbr_start, chunk, nbr):
+    """Write the neighbours of every particle into ``nbr`` (CSR by ``nbr_start``).
+
+    Parallel over chunks of ``chunk`` particles, each with its own search buffer.
+    """
+    n = x.shape[0]
+    width = 0
+    for i in range(n):
+        width = max(width, nbr_start[i + 1] - nbr_start[i])
+    for c in prange((n + chunk - 1) // chunk):
+        buf = np.empty(width + 2, dtype=np.int64)
+        for i in range(c * chunk, min(n, (c + 1) * chunk)):
+            k = _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx,
+                        lv_ncy, lv_off, lv_hmax, reach, buf, True)
+            pos = nbr_start[i]
+            for q in range(k):
+                if buf[q] != i:
+                    nbr[pos] = buf[q]
+                    pos += 1
+
+
+@njit(parallel=True, cache=True)
+def _within_support(x, y, h, nstart, nbr):
+    """Number of listed directed pairs with r_ij < 2 max(h_i, h_j)."""
+    total = 0
+    for i in prange(x.shape[0]):
+        k = 0
+        for q in range(nstart[i], nstart[i + 1]):
+            j = nbr[q]
+            r = 2.0 * max(h[i], h[j])
+            k += (x[j] - x[i]) ** 2 + (y[j] - y[i]) ** 2 < r * r
+        total += k
+    return total
+
+
+@njit(parallel=True, cache=True)
+def _motion(x, y, h, x_b, y_b, h_b):
+    """max_i h_i / h_b,i and max_i |x_i - x_b,i| / h_b,i since the list was built."""
+    grow = 0.0
+    move = 0.0
+    for i in prange(x.shape[0]):
+        grow = max(grow, h[i] / h_b[i])
+        move = max(move, math.hypot(x[i] - x_b[i], y[i] - y_b[i]) / h_b[i])
+    return grow, move
 
 
 class NeighbourList:
     """CSR neighbour lists: the neighbours of i are ``nbr[start[i]:start[i + 1]]``.
+
+    Every pair with r_ij < 2 (1 + skin) max(h_i, h_j) at the build is listed (a superset of
+    the interacting pairs; kernels skip the listed pairs beyond the support).
 
     Parameters
     ----------
     x, y, h : float64 arrays
         Positions [m] and smoothing lengths [m] of the active particles.
     skin : float
-        Relative margin on the 2 max(h_i, h_j) support; the list stays exact while no h
-        grows by more than this fraction (see :meth:`still_valid`).
+        Relative margin on the 2 max(h_i, h_j) support (see :meth:`still_valid`).
     """
 
     def __init__(self, x, y, h, skin=0.1):
         n = x.shape[0]
         self.skin = skin
         self.reach = 2.0 * (1.0 + skin)
+        self.x_built = x.copy()
+        self.y_built = y.copy()
         self.h_built = h.copy()
+        self.start = np.zeros(n + 1, dtype=np.int64)
         if n == 0:
-            self.start = np.zeros(1, dtype=np.int64)
             self.nbr = np.zeros(0, dtype=np.int64)
             return
-        h_max = float(h.max())
-        h_cut = min(h_max, 2.0 * float(h.mean()))
-        big = h > h_cut
-        if big.sum() > 0.05 * n:
-            h_cut = h_max
-            big[:] = False
-        big_idx = np.flatnonzero(big).astype(np.int64)
-        grid = CellGrid(x, y, self.reach * h_cut)
-        start = np.zeros(n + 1, dtype=np.int64)
-        dummy = np.zeros(0, dtype=np.int64)
-        args = (x, y, h, big, big_idx, *grid.arrays(), self.reach, h_cut)
-        _scan(*args, start, dummy, False)
-        np.cumsum(start, out=start)
-        nbr = np.empty(start[-1], dtype=np.int64)
-        _scan(*args, start, nbr, True)
-        self.start = start
-        self.nbr = nbr
+        level = np.empty(n, dtype=np.int64)
+        lv_hmax, box = _levels(x, y, h, LEVEL_BASE * float(np.median(h)), level)
+        used = lv_hmax > 0.0
+        width = np.where(used, box[:, 2] - box[:, 0], 0.0)
+        height = np.where(used, box[:, 3] - box[:, 1], 0.0)
+        members = np.bincount(level, minlength=lv_hmax.shape[0])
+        # cells of the level's reach, coarser where that would give more cells than particles
+        lv_cell = np.where(used, np.maximum(self.reach * lv_hmax,
+                                            np.sqrt(width * height / (members + 1.0))), 0.0)
+        safe = np.where(used, lv_cell, 1.0)
+        lv_ncx = np.where(used, np.floor(width / safe), 0).astype(np.int64) + 1
+        lv_ncy = np.where(used, np.floor(height / safe), 0).astype(np.int64) + 1
+        lv_off = np.zeros(lv_hmax.shape[0] + 1, dtype=np.int64)
+        np.cumsum(lv_ncx * lv_ncy, out=lv_off[1:])
+        cid = np.empty(n, dtype=np.int64)
+        _level_cell_ids(x, y, level, box, lv_cell, lv_ncx, lv_ncy, lv_off, cid)
+        cell_start, order = counting_sort(cid, int(lv_off[-1]), _chunks(n))
+        args = (x, y, h, x[order], y[order], h[order], order, cell_start, box, lv_cell, lv_ncx,
+                lv_ncy, lv_off, lv_hmax, self.reach)
+        _count(*args, self.start)
+        np.cumsum(self.start, out=self.start)
+        self.nbr = np.empty(self.start[-1], dtype=np.int64)
+        _fill(*args, self.start, 1024, self.nbr)
 
-    def still_valid(self, h) -> bool:
-        """True while every h is within the skin of the h the list was built with."""
-        return bool(np.all(h <= self.h_built * (1.0 + self.skin)))
+    def still_valid(self, x, y, h) -> bool:
+        """True while the list still holds every pair with r_ij < 2 max(h_i, h_j).
+
+        With G = max h_i / h_b,i and D = max |x_i - x_b,i| / h_b,i (b: at the build), a pair
+        within the support now was within 2 (G + D) max(h_b,i, h_b,j) at the build, so the
+        list is exact while G + D <= 1 + skin (same particle count required).
+        """
+        if x.shape[0] != self.x_built.shape[0]:
+            return False
+        if x.shape[0] == 0:
+            return True
+        grow, move = _motion(x, y, h, self.x_built, self.y_built, self.h_built)
+        return grow + move <= 1.0 + self.skin
 
     def count(self) -> int:
-        """Number of directed pairs."""
+        """Number of listed directed pairs (within the skin)."""
         return int(self.nbr.shape[0])
+
+    def interactions(self, x, y, h) -> int:
+        """Number of directed pairs that interact now, r_ij < 2 max(h_i, h_j)."""
+        return int(_within_support(x, y, h, self.start, self.nbr))

@@ -17,10 +17,12 @@ the edges are closed. Three mechanisms keep water on its side:
    right-angled corner), which completes the kernel there too.
 2. **Pair blocking.** Particles on opposite sides of a wall do not interact.
 3. **Crossing guard.** A drift step that would cross a wall is reflected about it (position and
-   normal velocity), so no particle ever crosses, whatever the time step.
+   normal velocity), so no particle ever crosses, whatever the time step (:func:`drift`).
 
-Near-wall lists are CSR arrays ``(wstart, wseg)`` built per step for the particles within the
-interaction radius of a segment; most particles have none and pay nothing.
+Near-wall lists are CSR arrays ``(wstart, wseg)`` built with the neighbour lists, with the
+same skin, for the particles within the interaction radius of a segment (and kept as long as
+the neighbour lists are: a wall within the support now was within the skinned radius at the
+build); most particles have none and pay nothing.
 """
 
 from __future__ import annotations
@@ -87,7 +89,7 @@ class WallIndex:
         wstart = np.zeros(n + 1, dtype=np.int64)
         if self.seg.shape[0] == 0 or n == 0:
             return wstart, np.zeros(0, dtype=np.int64)
-        args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items,
+        args = (x, y, h, float(h.max()), nstart, nbr, reach, self.seg, self.start, self.items,
                 self.xmin, self.ymin, self.bucket, self.nbx, self.nby, self.margin)
         _near_scan(*args, wstart, np.zeros(0, dtype=np.int64), False)
         np.cumsum(wstart, out=wstart)
@@ -107,18 +109,20 @@ def segment_distance(px, py, x1, y1, x2, y2):
 
 
 @njit(parallel=True, cache=True)
-def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, bxmin, bymin, bucket, nbx, nby,
-               margin, wstart, wseg, fill):
+def _near_scan(x, y, h, h_max, nstart, nbr, reach, seg, bstart, items, bxmin, bymin, bucket,
+               nbx, nby, margin, wstart, wseg, fill):
     for i in prange(x.shape[0]):
+        bx = min(max(int((x[i] - bxmin) // bucket), 0), nbx - 1)
+        by = min(max(int((y[i] - bymin) // bucket), 0), nby - 1)
+        b = by * nbx + bx
+        if bstart[b] == bstart[b + 1] and reach * h_max <= margin:
+            continue  # no segment within the margin, and no radius beyond it: none listed
         hr = h[i]
         for k in range(nstart[i], nstart[i + 1]):
             hr = max(hr, h[nbr[k]])
         radius = reach * hr
         k = 0
         if radius <= margin:
-            bx = min(max(int((x[i] - bxmin) // bucket), 0), nbx - 1)
-            by = min(max(int((y[i] - bymin) // bucket), 0), nby - 1)
-            b = by * nbx + bx
             for q in range(bstart[b], bstart[b + 1]):
                 s = items[q]
                 dist = segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
@@ -211,26 +215,30 @@ def corner_image(px, py, seg, s1, s2):
 
 
 @njit(parallel=True, cache=True)
-def guard_crossings(x_old, y_old, x, y, u, v, wstart, wseg, seg):
-    """Reflect drift moves that cross a wall (position and normal velocity). Returns count.
+def drift(x, y, u, v, dt, wstart, wseg, seg):
+    """Drift x <- x + dt v, reflecting moves that cross a wall. Returns the reflection count.
 
-    A move x_old -> x that meets a segment is mirrored about the segment's line and the
-    velocity's normal component reversed; after three reflections (a corner) the particle is
-    put back to x_old with zero velocity.
+    A move x_old -> x that meets a segment of the particle's near-wall list is mirrored about
+    the segment's line and the velocity's normal component reversed; after three reflections
+    (a corner) the particle is put back to x_old with zero velocity.
     """
-    hits = np.zeros(x.shape[0], dtype=np.int64)
+    total = 0
     for i in prange(x.shape[0]):
+        x_old = x[i]
+        y_old = y[i]
+        x[i] = x_old + dt * u[i]
+        y[i] = y_old + dt * v[i]
+        hits = 0
         for _ in range(3):
             hit = -1
             for k in range(wstart[i], wstart[i + 1]):
                 s = wseg[k]
-                if crosses(x_old[i], y_old[i], x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2],
-                           seg[s, 3]):
+                if crosses(x_old, y_old, x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]):
                     hit = s
                     break
             if hit < 0:
                 break
-            hits[i] += 1
+            hits += 1
             xm, ym, _, nx, ny = mirror(x[i], y[i], seg[hit, 0], seg[hit, 1], seg[hit, 2],
                                        seg[hit, 3])
             x[i] = xm
@@ -238,12 +246,13 @@ def guard_crossings(x_old, y_old, x, y, u, v, wstart, wseg, seg):
             vn = u[i] * nx + v[i] * ny
             u[i] -= 2.0 * vn * nx
             v[i] -= 2.0 * vn * ny
-        if hits[i] >= 3:
-            x[i] = x_old[i]
-            y[i] = y_old[i]
+        if hits >= 3:
+            x[i] = x_old
+            y[i] = y_old
             u[i] = 0.0
             v[i] = 0.0
-    return hits.sum()
+        total += hits
+    return total
 
 
 def mask_boundary_segments(valid: np.ndarray, dx: float, dy: float) -> np.ndarray:

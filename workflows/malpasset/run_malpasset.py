@@ -1,159 +1,176 @@
 """Malpasset dam failure (France, 2 Dec 1959) with floodsph on the 20 m EPSG:27572 DEM.
 
 Reads the benchmark data from ``$FLOODSPH_BENCHMARKS/malpasset`` or
-``<repo>/../shared/benchmarks/malpasset`` (never copied into the repository), writes a
-scenario TOML (absolute paths to the data) and a gauges CSV into the results folder, and runs
-it. Benchmark definition (SOURCE.md there): instantaneous total failure; reservoir at 100 m on
-the upstream side of the dam axis, except a dry circle of radius 200 m; Manning n = 0.033;
-closed boundaries; 4000 s. Local model frame to EPSG:27572:
-``X = y_local + 953595``, ``Y = 1849222 - x_local`` (a rotation by -90 degrees, so the side
-of a line is preserved).
+``<repo>/../shared/benchmarks/malpasset`` (never copied into the repository), writes the
+scenario (``malpasset_setup``), runs it and reports (``malpasset_results``): the simulated
+maximum water level at the survey points P1-P17 and gauges S6-S14, arrival times (depth >
+0.05 m) at S6-S14 and the transformers A, B, C, maximum-level maps, the particle count over
+time and the cost of the run. The sea is either particles (the benchmark's still sea at 0 m)
+or a sink (``--sea``); ``--sea both`` runs both, each in its own process so that each peak
+memory figure is its own.
 
-Usage: ``python workflows/malpasset/run_malpasset.py --end-time 5 --out /tmp/mp``
+Results folder (default ``workflows/malpasset/results``):
+
+* ``<sea>/``: ``malpasset.toml``, ``gauges_epsg27572.csv``, the run folder ``run/``,
+  ``points.csv``, ``particles.csv`` (time, particles, wall time, outflow), ``cost.json``,
+  ``max_level.png``;
+* ``malpasset_points.csv`` and ``malpasset_costs.csv`` (all sea modes run so far, one row per
+  point / per mode) and ``particles.png`` (particle count and wall time against time).
+
+Usage: ``python workflows/malpasset/run_malpasset.py [--sea particles|sink|both]
+[--end-time S] [--spacing M] [--out DIR] [--overwrite] [--max-steps N]``
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
-import math
-import os
+import json
+import resource
+import subprocess
 import sys
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
-DEM_NAME = "malpasset_dem_epsg27572_20m.tif"
-DAM_LOCAL = ((4701.183, 4143.407), (4655.553, 4392.104))
-DRY_CIRCLE_LOCAL = (4500.0, 5350.0, 200.0)
-CIRCLE_VERTICES = 72
-RESERVOIR_LEVEL_M = 100.0
-MANNING_N = 0.033
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import malpasset_results as results  # noqa: E402
+import malpasset_setup as setup  # noqa: E402
+
+DEFAULT_OUT = setup.REPO / "workflows" / "malpasset" / "results"
+PARTICLE_COUNT_INTERVAL_S = 10.0
 
 
-def to_27572(x_local: float, y_local: float) -> tuple[float, float]:
-    """Local Malpasset frame [m] to NTF (Paris) / Lambert zone II etendu (EPSG:27572) [m]."""
-    return y_local + 953595.0, 1849222.0 - x_local
+def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_TIME_S,
+                spacing: float = 20.0, gauge_interval: float = 5.0, overwrite: bool = False,
+                max_steps: int | None = None, progress: bool = True,
+                threads: int | None = None) -> dict:
+    """Write, run and report one sea mode in ``out/<sea>/``; returns its cost row."""
+    from floodsph.run import run_scenario
+    from floodsph.scenario import load_scenario
+    from floodsph.schedules import TimeInterval
+
+    where = out / sea
+    path = setup.write_scenario(folder, where, sea, end_time, spacing, gauge_interval)
+    counter = results.ParticleCounter()
+    run_dir = where / "run"
+    run_scenario(load_scenario(path), out_dir=run_dir, overwrite=overwrite, progress=progress,
+                 max_steps=max_steps, threads=threads,
+                 callbacks=[(counter, TimeInterval(PARTICLE_COUNT_INTERVAL_S))])
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    counter.write_csv(where / "particles.csv")
+    points = setup.read_points(folder)
+    dem = folder / setup.DEM_NAME
+    rows = results.point_table(run_dir, dem, points, sea)
+    results.write_rows(where / "points.csv", results.POINT_COLUMNS, rows)
+    cost = results.cost_row(run_dir, sea, peak_mb)
+    (where / "cost.json").write_text(json.dumps(cost, indent=2) + "\n")
+    results.plot_max_level(run_dir, dem, points, where / "max_level.png",
+                           f"Malpasset, sea as {sea}: maximum water level, "
+                           f"t = 0-{cost['sim_time_s']:g} s")
+    return cost
 
 
-def data_folder() -> Path:
-    """The malpasset benchmark folder, or exit with a message saying where it was looked for."""
-    root = os.environ.get("FLOODSPH_BENCHMARKS")
-    base = Path(root) if root else REPO.parent / "shared" / "benchmarks"
-    folder = base / "malpasset"
-    if not (folder / DEM_NAME).is_file():
-        sys.exit(f"Malpasset data not found: {folder / DEM_NAME} is missing. Set "
-                 "FLOODSPH_BENCHMARKS to the folder holding malpasset/.")
-    return folder
+def summarise(out: Path) -> tuple[list[dict], list[dict]]:
+    """Gather the sea modes run in ``out``: malpasset_points.csv, _costs.csv, particles.png.
 
-
-def clip_left(poly: list, a, b) -> list:
-    """Sutherland-Hodgman: the part of polygon ``poly`` left of the line a -> b.
-
-    Left means cross(b - a, p - a) > 0, the upstream (reservoir) side of the dam axis as
-    ordered in the benchmark (TELEMAC corsui.f signed distance > 0).
+    A mode counts when its run folder holds a completed run and its report (cost.json).
     """
-    def side(p):
-        return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+    import csv
 
-    out = []
-    for k, p in enumerate(poly):
-        q = poly[(k + 1) % len(poly)]
-        sp, sq = side(p), side(q)
-        if sp >= 0:
-            out.append(p)
-        if (sp >= 0) != (sq >= 0):
-            t = sp / (sp - sq)
-            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
-    return out
+    from floodsph.manifest import read_manifest
 
-
-def reservoir_polygon(bounds) -> list:
-    """The DEM box upstream of the dam axis with the dry circle cut out as a keyhole.
-
-    The hole is the upstream part of the circle (a regular polygon of CIRCLE_VERTICES
-    vertices on the circle, clipped by the dam axis), joined to the first outer vertex by a
-    zero-width slit traversed both ways: floodsph's even-odd point-in-polygon test counts the
-    two slit edges twice, so they cancel and the hole stays dry.
-    """
-    left, bottom, right, top = bounds
-    box = [(left, bottom), (right, bottom), (right, top), (left, top)]
-    a, b = (to_27572(*p) for p in DAM_LOCAL)
-    outer = clip_left(box, a, b)
-    cx, cy = to_27572(DRY_CIRCLE_LOCAL[0], DRY_CIRCLE_LOCAL[1])
-    r = DRY_CIRCLE_LOCAL[2]
-    circle = [(cx + r * math.cos(2 * math.pi * k / CIRCLE_VERTICES),
-               cy - r * math.sin(2 * math.pi * k / CIRCLE_VERTICES))
-              for k in range(CIRCLE_VERTICES)]
-    # The circle straddles the extended dam axis: only its upstream part is a hole (the rest
-    # is outside the reservoir anyway, and would be filled by the even-odd rule otherwise).
-    hole = clip_left(circle, a, b)
-    ring = [outer[0], *hole, hole[0], outer[0], *outer[1:], outer[0]]
-    return [[round(x, 3), round(y, 3)] for x, y in ring]
+    points, costs, curves = [], [], {}
+    for sea in setup.SEA_MODES:
+        cost_file = out / sea / "cost.json"
+        manifest = read_manifest(out / sea / "run") or {}
+        if manifest.get("status") != "completed" or not cost_file.is_file():
+            continue
+        costs.append(json.loads(cost_file.read_text()))
+        with open(out / sea / "points.csv", newline="") as f:
+            points += list(csv.DictReader(f))
+        curves[sea] = out / sea / "particles.csv"
+    if costs:
+        results.write_rows(out / "malpasset_points.csv", results.POINT_COLUMNS, points)
+        results.write_rows(out / "malpasset_costs.csv", results.COST_COLUMNS, costs)
+        results.plot_particles(curves, out / "particles.png")
+    return points, costs
 
 
-def write_gauges(folder: Path, path: Path) -> Path:
-    """gauge_locations.csv -> ``id,x,y`` in EPSG:27572 (converted from the local frame)."""
-    with open(folder / "gauge_locations.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["id", "x", "y"])
-        for row in rows:
-            x, y = to_27572(float(row["x_local_m"]), float(row["y_local_m"]))
-            w.writerow([row["id"], f"{x:.1f}", f"{y:.1f}"])
-    return path
+def _print(points: list[dict], costs: list[dict]) -> None:
+    for c in costs:
+        print(f"sea as {c['sea']}: {c['status']}, t = {c['sim_time_s']:g} s in {c['steps']} "
+              f"steps, particles {c['particles_initial']} -> {c['particles_final']} (max "
+              f"{c['particles_max']}), wall {c['wall_time_s']:.1f} s, peak memory "
+              f"{c['peak_rss_mb']:.0f} MB, outflow {c['volume_out_m3']:.4g} m3, mass error "
+              f"{c['mass_error_rel']:.1e}")
+    print(f"{'sea':<10}{'id':<5}{'bed':>8}{'max lvl':>9}{'r40 lvl':>9}{'arrival':>9}")
+    for p in points:
+        print(f"{p['sea']:<10}{p['id']:<5}" + "".join(
+            f"{float(p[k]):>9.2f}" for k in ("bed_m", "max_level_m", "max_level_r40_m"))
+            + f"{float(p['arrival_time_s']):>9.0f}")
 
 
-def write_scenario(folder: Path, out: Path, end_time: float, spacing: float) -> Path:
-    """The scenario TOML in ``out`` (absolute data paths); returns its path."""
-    import rasterio
-
-    from floodsph.toml_writer import dumps
-
-    dem = folder / DEM_NAME
-    with rasterio.open(dem) as src:
-        bounds = tuple(src.bounds)
-    gauges = write_gauges(folder, out / "gauges_epsg27572.csv")
-    scenario = {
-        "scenario": {
-            "name": "malpasset",
-            "end_time_s": end_time,
-            "description": "Malpasset dam failure 1959: instantaneous total failure, "
-                           "reservoir at 100 m; sea dry, closed domain (no sinks yet)",
-        },
-        "terrain": {"dem": str(dem), "manning": MANNING_N, "edges": "closed"},
-        "initial_water": [{"level_m": RESERVOIR_LEVEL_M,
-                           "polygon": reservoir_polygon(bounds)}],
-        "gauges": {"file": str(gauges), "interval_s": 10.0},
-        "numerics": {"particle_spacing_m": spacing},
-    }
-    path = out / "malpasset.toml"
-    path.write_text(dumps(scenario), encoding="utf-8")
-    return path
+def _child(args, sea: str) -> int:
+    """Run one sea mode in a new process (its own peak memory); its exit status."""
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--sea", sea, "--no-summary",
+           "--end-time", repr(args.end_time), "--spacing", repr(args.spacing),
+           "--gauge-interval", repr(args.gauge_interval), "--out", str(args.out)]
+    cmd += ["--overwrite"] if args.overwrite else []
+    cmd += ["--max-steps", str(args.max_steps)] if args.max_steps else []
+    cmd += ["--threads", str(args.threads)] if args.threads is not None else []
+    return subprocess.run(cmd, check=False).returncode
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--end-time", type=float, default=4000.0, help="simulated time [s]")
+    parser.add_argument("--sea", choices=(*setup.SEA_MODES, "both"), default="particles",
+                        help="the sea as still-water particles (the benchmark), a sink, or both")
+    parser.add_argument("--end-time", type=float, default=setup.END_TIME_S,
+                        help="simulated time [s] (default 4000)")
     parser.add_argument("--spacing", type=float, default=20.0,
                         help="particle_spacing_m [m] (default 20, the DEM cell)")
-    parser.add_argument("--out", type=Path, default=REPO / "workflows" / "malpasset" / "results",
-                        help="results folder (scenario, gauges, run folder 'run/')")
-    parser.add_argument("--overwrite", action="store_true", help="replace an earlier run")
+    parser.add_argument("--gauge-interval", type=float, default=5.0,
+                        help="gauge sampling interval [s]: the resolution of arrival times")
+    parser.add_argument("--out", type=Path, default=DEFAULT_OUT, help="results folder")
+    parser.add_argument("--overwrite", action="store_true", help="replace earlier runs")
+    parser.add_argument("--max-steps", type=int, default=None, help="stop after N steps")
+    parser.add_argument("--threads", type=int, default=None,
+                        help="numba threads (default: all cores)")
+    parser.add_argument("--no-summary", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--write-static", action="store_true",
+                        help="(re)write workflows/malpasset/scenario.toml and exit")
     args = parser.parse_args(argv)
 
-    folder = data_folder()
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    folder = setup.data_folder()
+    if folder is None:
+        sys.exit("Malpasset data not found: set FLOODSPH_BENCHMARKS to the folder holding "
+                 f"malpasset/{setup.DEM_NAME} (default <repo>/../shared/benchmarks).")
+    if args.write_static:
+        static = setup.write_static_scenario(folder, Path(__file__).parent / "scenario.toml")
+        print(f"wrote {static}")
+        return 0
+    args.out = args.out.resolve()
+    status = 0
+    if args.sea == "both":
+        for sea in setup.SEA_MODES:
+            code = _child(args, sea)
+            if code:
+                print(f"sea as {sea}: failed (exit status {code})", file=sys.stderr)
+                status = 1
+    else:
+        from floodsph.errors import InputError
 
-    out = args.out.resolve()
-    out.mkdir(parents=True, exist_ok=True)
-    path = write_scenario(folder, out, args.end_time, args.spacing)
-    manifest = run_scenario(load_scenario(path), out_dir=out / "run", overwrite=args.overwrite)
-    print(f"{manifest['status']}: t = {manifest['sim_time_s']:g} s, {manifest['steps']} steps, "
-          f"{manifest['particles_initial']} particles, mass error "
-          f"{manifest['mass_error_rel']:.2e}; maps in {out / 'run'}")
-    return 0
+        try:
+            run_variant(folder, args.out, args.sea, args.end_time, args.spacing,
+                        args.gauge_interval, args.overwrite, args.max_steps,
+                        threads=args.threads)
+        except InputError as exc:
+            print(f"Error: {exc}", file=sys.stderr)
+            return 2
+    if not args.no_summary:
+        points, costs = summarise(args.out)
+        _print(points, costs)
+        print(f"results in {args.out}")
+    return status
 
 
 if __name__ == "__main__":

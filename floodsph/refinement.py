@@ -1,0 +1,268 @@
+"""Dynamic refinement: particle splitting and coalescing (Vacondio et al. 2013).
+
+A particle's area A_i = m_i / rho_i [m2] grows as its depth d_i = rho_i / rho_w shrinks, so a
+thin flood front is carried by few, huge particles. :class:`Refiner` splits such particles
+into seven daughters (method notes section 4) and coalesces pairs of small ones where the
+water has deepened again (section 5), so that the particle count follows the flow's needs.
+The numerics live in :mod:`floodsph.sph.refine`; this module selects the particles and does
+the bookkeeping. Total mass and linear momentum are unchanged to round-off by every split
+and every merge.
+
+Criteria (thresholds are multiples of the initial particle area A0 = spacing^2):
+
+* split p when A_p > area_max A0, d_p >= d_min, level_p < max_level, and all seven daughters
+  land on valid terrain on the parent's side of every wall, outside open-boundary zones;
+* merge a and b when A < area_min A0 for both, each is the other's nearest neighbour, they are
+  closer than min(h_a, h_b), neither is near a wall or an open boundary
+  (``FloodModel.protected``), neither was born (split, merge or inflow) in the last
+  ``no_merge_steps`` steps, |d_a - d_b| <= depth_jump max(d_a, d_b) and
+  |v_a - v_b| <= speed_jump sqrt(g max(d_a, d_b)) (no merging across fronts and bores).
+
+New particles (method notes 4.3 and 5): daughters take h = 0.9 h_p, merged particles the h_M
+of ``floodsph.sph.refine.merged_h`` (floored at the lattice value kappa sqrt(A_M), see there).
+Both get the reference values h0 = h and rho0 = rho (their smoothing length and density guess
+at creation: for a daughter rho0 = rho_p, h0 = 0.9 h_p, the notes' h0_k = 0.9 h0_p, rho0_k =
+rho0_p re-based to the parent's current state), so that the relation h = h0 (rho0 / rho)^(1/2)
+of the density solve holds at creation and h stays consistent with density afterwards.
+Daughters keep the parent's velocity, which conserves momentum exactly (the notes' optional
+c_v (d_N / d_k) v_N rescaling is not applied).
+
+Hysteresis (defaults). A parent split at A = area_max A0 = 2 A0 leaves daughters of area
+0.137 - 0.179 times its own, 0.27 - 0.36 A0, above area_min = 0.2 A0: a daughter becomes a
+merge candidate only once its depth has grown by a third or more, and a merged pair (about
+0.4 A0) splits again only once its depth has fallen five-fold, so particles do not cycle.
+d_min = 0.01 m is the default wet threshold of the maps and the friction depth floor: water
+thinner than that is invisible on every output and dominated by the friction floor, and
+refining it would only add particles.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from floodsph.constants import GRAVITY, RHO_WATER
+from floodsph.errors import InputError
+
+MODES = ("split+coalesce", "split", "none")
+
+
+@dataclass(frozen=True)
+class Refinement:
+    """Settings of splitting and coalescing (see the module docstring for the criteria).
+
+    mode : "split+coalesce", "split" or "none".
+    area_max : split above this area, in units of the initial particle area spacing^2.
+    area_min : merge candidates are below this area, same units (area_min < area_max / 7).
+    d_min : no splitting of particles shallower than this [m].
+    max_level : at most this many generations of splitting.
+    no_merge_steps : particles born within this many steps are not merged.
+    merge_interval : look for merges every this many steps.
+    depth_jump : no merge when |d_a - d_b| > depth_jump max(d_a, d_b).
+    speed_jump : no merge when |v_a - v_b| > speed_jump sqrt(g max(d_a, d_b)).
+    """
+
+    mode: str = "split+coalesce"
+    area_max: float = 2.0
+    area_min: float = 0.2
+    d_min: float = 0.01
+    max_level: int = 3
+    no_merge_steps: int = 10
+    merge_interval: int = 5
+    depth_jump: float = 0.2
+    speed_jump: float = 0.2
+
+    def __post_init__(self):
+        if self.mode not in MODES:
+            raise InputError(f"numerics.refinement: {self.mode!r} is not one of {list(MODES)}")
+        if not 0.0 < self.area_min < self.area_max / 7.0:
+            raise InputError(
+                f"refinement: need 0 < area_min < area_max / 7 so that daughters do not merge "
+                f"back at once; got area_min={self.area_min}, area_max={self.area_max}")
+        if self.d_min < 0.0 or self.max_level < 0 or self.no_merge_steps < 0:
+            raise InputError("refinement: d_min, max_level and no_merge_steps must be >= 0")
+        if self.merge_interval < 1:
+            raise InputError(f"refinement: merge_interval must be >= 1, got "
+                             f"{self.merge_interval}")
+
+    @property
+    def splits(self) -> bool:
+        return self.mode != "none"
+
+    @property
+    def coalesces(self) -> bool:
+        return self.mode == "split+coalesce"
+
+
+class Refiner:
+    """Splits and coalesces the particles of a ``FloodModel`` (its ``refiner`` hook).
+
+    Parameters
+    ----------
+    settings : Refinement
+    spacing : float
+        Initial particle spacing [m]; the area thresholds are multiples of spacing^2.
+    """
+
+    def __init__(self, settings: Refinement, spacing: float):
+        if not spacing > 0.0:
+            raise InputError(f"refinement: particle spacing must be > 0 m, got {spacing}")
+        self.settings = settings
+        self.spacing = float(spacing)
+        self.area_max = settings.area_max * self.spacing**2
+        self.area_min = settings.area_min * self.spacing**2
+
+    @classmethod
+    def from_settings(cls, mode: str, spacing: float, **overrides) -> Refiner | None:
+        """The refiner of a scenario's ``numerics.refinement`` mode (None for "none")."""
+        settings = Refinement(mode=mode, **overrides)
+        return cls(settings, spacing) if settings.splits else None
+
+    def __repr__(self) -> str:
+        return f"Refiner({self.settings}, spacing={self.spacing})"
+
+    def apply(self, model) -> tuple[int, int]:
+        """Split and coalesce the particles of ``model`` in place; return (splits, merges).
+
+        Called by ``FloodModel.step`` after the drift and the density prediction; the step
+        then rebuilds the neighbour lists and solves density and h for all particles.
+        """
+        s = self.settings
+        if not s.splits or model.particles.n == 0:
+            return 0, 0
+        parents = self.split_candidates(model)
+        a = b = np.zeros(0, dtype=np.int64)
+        if s.coalesces and model.steps % s.merge_interval == 0:
+            a, b = self.merge_pairs(model)
+        if parents.size == 0 and a.size == 0:
+            return 0, 0
+        return self.execute(model, parents, a, b)
+
+    def execute(self, model, parents, a, b) -> tuple[int, int]:
+        """Split the particles ``parents`` and merge the pairs (a[k], b[k]); return the counts.
+
+        The index arrays refer to the current particle order and must be disjoint. The
+        parents and the pairs are removed, the daughters and merged particles appended, and the
+        model's neighbour lists rebuilt; density and h are solved by the model's next step.
+        """
+        parents, a, b = (np.asarray(i, dtype=np.int64) for i in (parents, a, b))
+        born = self._split(model, parents)
+        merged = self._merged(model, a, b)
+        keep = np.ones(model.particles.n, dtype=bool)
+        keep[parents] = False
+        keep[a] = False
+        keep[b] = False
+        p = model.particles
+        p.keep(keep)
+        for fields in (born, merged):
+            if fields is not None:
+                p.append(**fields)
+        model.nl = None  # the particles changed: rebuild the neighbour and near-wall lists
+        model._neighbours()
+        return int(parents.size), int(a.size)
+
+    # -- splitting ---------------------------------------------------------------------------
+    def split_candidates(self, model) -> np.ndarray:
+        """Indices of the particles to split (criteria in the module docstring)."""
+        from floodsph.sph import refine
+
+        p = model.particles
+        s = self.settings
+        big = (p.m > self.area_max * p.rho) & (p.rho >= RHO_WATER * s.d_min)
+        big &= p.level < s.max_level
+        for boundary in getattr(model, "boundaries", ()):
+            big &= ~boundary.protected(p.x, p.y)
+        idx = np.flatnonzero(big)
+        if idx.size == 0:
+            return idx
+        x, y, _ = self._daughter_positions(p, idx)
+        ok = _on_terrain(model.terrain, x, y).reshape(-1, refine.DAUGHTERS).all(axis=1)
+        wi = model.wall_index
+        if wi.seg.shape[0]:
+            clear = np.empty(idx.size, dtype=np.bool_)
+            refine.daughters_clear(p.x[idx], p.y[idx], x, y, wi.seg, wi.start, wi.items,
+                                   wi.xmin, wi.ymin, wi.bucket, wi.nbx, wi.nby, wi.margin,
+                                   clear)
+            ok &= clear
+        return idx[ok]
+
+    @staticmethod
+    def _daughter_positions(p, idx):
+        from floodsph.sph import refine
+
+        n = refine.DAUGHTERS * idx.size
+        x, y, m = np.empty(n), np.empty(n), np.empty(n)
+        refine.daughters(p.x[idx], p.y[idx], p.u[idx], p.v[idx], p.m[idx], p.h[idx],
+                         refine.EPS, refine.STILL_SPEED, x, y, m)
+        return x, y, m
+
+    def _split(self, model, idx) -> dict | None:
+        """Fields of the daughters of the parents ``idx`` (None if there are none)."""
+        from floodsph.sph import refine
+
+        if idx.size == 0:
+            return None
+        p = model.particles
+        x, y, m = self._daughter_positions(p, idx)
+        rep = np.repeat(idx, refine.DAUGHTERS)
+        h = refine.H_FACTOR * p.h[rep]
+        rho = p.rho[rep]
+        return dict(x=x, y=y, u=p.u[rep], v=p.v[rep], m=m, rho=rho, h=h, h0=h, rho0=rho,
+                    alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, model.steps))
+
+    # -- coalescing --------------------------------------------------------------------------
+    def merge_pairs(self, model) -> tuple[np.ndarray, np.ndarray]:
+        """Index arrays (a, b) of the particle pairs to merge, a < b (module docstring).
+
+        Rebuilds the model's neighbour lists when there are candidates.
+        """
+        from floodsph.sph import refine
+
+        p = model.particles
+        s = self.settings
+        cand = (p.m < self.area_min * p.rho) & (model.steps - p.born >= s.no_merge_steps)
+        empty = np.zeros(0, dtype=np.int64)
+        if cand.sum() < 2:
+            return empty, empty
+        model._neighbours()
+        cand &= ~model.protected()
+        nn = np.empty(p.n, dtype=np.int64)
+        refine.nearest_neighbour(p.x, p.y, model.nl.start, model.nl.nbr, nn)
+        a = np.flatnonzero(cand & (nn > np.arange(p.n)))
+        b = nn[a]
+        mutual = cand[b] & (nn[b] == a)
+        a, b = a[mutual], b[mutual]
+        d_a, d_b = p.rho[a] / RHO_WATER, p.rho[b] / RHO_WATER
+        d_max = np.maximum(d_a, d_b)
+        dv = np.hypot(p.u[a] - p.u[b], p.v[a] - p.v[b])
+        r = np.hypot(p.x[a] - p.x[b], p.y[a] - p.y[b])
+        ok = (np.abs(d_a - d_b) <= s.depth_jump * d_max)
+        ok &= dv <= s.speed_jump * np.sqrt(GRAVITY * d_max)
+        ok &= r < np.minimum(p.h[a], p.h[b])
+        return a[ok], b[ok]
+
+    @staticmethod
+    def _merged(model, a, b) -> dict | None:
+        """Fields of the particles merged from the pairs (a, b) (None if there are none)."""
+        from floodsph.sph import refine
+
+        if a.size == 0:
+            return None
+        p = model.particles
+        out = np.empty((a.size, 7))
+        refine.merge_pairs(a, b, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, model.numerics.kappa, out)
+        rho, h = out[:, 5], out[:, 6]
+        return dict(x=out[:, 0], y=out[:, 1], u=out[:, 2], v=out[:, 3], m=out[:, 4], rho=rho,
+                    h=h, h0=h, rho0=rho, alpha=2.0 * rho,
+                    level=np.minimum(p.level[a], p.level[b]), born=np.full(a.size, model.steps))
+
+
+def _on_terrain(terrain, x, y) -> np.ndarray:
+    """True for points on a valid cell of the terrain grid (local coordinates)."""
+    ny, nx = terrain.shape
+    col = np.floor(x / terrain.dx).astype(np.int64)
+    row = np.floor(y / terrain.dy).astype(np.int64)
+    inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
+    inside[inside] = terrain.valid[row[inside], col[inside]]
+    return inside

@@ -1,0 +1,303 @@
+"""Particle splitting and coalescing (floodsph.refinement, floodsph.sph.refine).
+
+Facts checked: every split and every merge conserves mass and momentum to round-off; the
+depth field survives a split and a merge; the merged smoothing length satisfies its kernel
+identity; daughters never land across a wall; splitting a coarse dam break improves it.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from floodsph import testing as exact
+from floodsph import verification as cases
+from floodsph.constants import RHO_WATER
+from floodsph.errors import InputError
+from floodsph.model import FloodModel, Numerics
+from floodsph.output.rasterise import interpolate
+from floodsph.refinement import Refinement, Refiner
+from floodsph.sph import refine
+from floodsph.sph.kernels import SIGMA_2D, w_cubic
+from floodsph.terrain import Terrain
+from tests.sph_cases import lattice, model_on, particles_with_depth
+
+
+def flat(x, y):
+    return 0.0 * x
+
+
+def jittered_pond(depth, size=30.0, dx=1.0, jitter=0.15, seed=1, u=0.0, v=0.0):
+    """A closed flat box of water on a jittered lattice (no exact nearest-neighbour ties)."""
+    rng = np.random.default_rng(seed)
+    terrain = Terrain.from_function(flat, (0, size), (0, size), 1.0)
+    x, y = lattice(0.0, size, 0.0, size, dx)
+    x = x + rng.uniform(-jitter, jitter, x.size)
+    y = y + rng.uniform(-jitter, jitter, y.size)
+    d = depth(x, y) if callable(depth) else np.full(x.size, depth)
+    uu = u(x, y) if callable(u) else u
+    vv = v(x, y) if callable(v) else v
+    p = particles_with_depth(x, y, d, dx, 1.3, u=uu, v=vv)
+    return FloodModel(terrain, p, Numerics(spacing=dx, kappa=1.3))
+
+
+def totals(p):
+    """Mass [kg], momentum (2,) [kg m/s] and the momentum scale sum m |v| of a particle set."""
+    mom = np.array([np.sum(p.m * p.u), np.sum(p.m * p.v)])
+    return p.m.sum(), mom, np.sum(p.m * np.hypot(p.u, p.v))
+
+
+def shepard_depth(model, x, y):
+    p = model.particles
+    return interpolate(np.asarray(x), np.asarray(y), p.x, p.y, p.u, p.v, p.m, p.rho, p.h)[0]
+
+
+def solve_in_place(model):
+    """Let the model solve density and h without moving anything (a 1e-9 s step)."""
+    model.step(dt_max=1e-9)
+
+
+# -- settings ------------------------------------------------------------------------------------
+def test_settings_reject_thresholds_without_hysteresis():
+    with pytest.raises(InputError, match=r"area_min < area_max / 7.*area_min=0\.5, area_max=2"):
+        Refinement(area_max=2.0, area_min=0.5)
+    with pytest.raises(InputError, match=r"numerics.refinement: 'coarsen' is not one of"):
+        Refinement(mode="coarsen")
+    assert Refiner.from_settings("none", 10.0) is None
+    r = Refiner.from_settings("split", 10.0)
+    assert r.area_max == pytest.approx(2.0 * 100.0) and not r.settings.coalesces
+
+
+# -- splitting -----------------------------------------------------------------------------------
+def test_each_split_conserves_mass_and_momentum():
+    model = jittered_pond(lambda x, y: 0.5 + 0.02 * x, u=lambda x, y: 1.0 + 0.1 * y,
+                          v=lambda x, y: -0.5 + 0.05 * x)
+    p = model.particles
+    refiner = Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0)
+    parents = refiner.split_candidates(model)
+    interior = parents[(p.x[parents] > 3) & (p.x[parents] < 27)]
+    m_p, mu_p, mv_p = p.m[interior].copy(), (p.m * p.u)[interior], (p.m * p.v)[interior]
+    x_p, y_p, h_p = p.x[interior].copy(), p.y[interior].copy(), p.h[interior].copy()
+    heading = np.arctan2(p.v[interior], p.u[interior])
+    mass0, mom0, scale = totals(p)
+    assert refiner.execute(model, interior, [], []) == (interior.size, 0)
+    daughters = slice(p.n - 7 * interior.size, p.n)
+    m_k = p.m[daughters].reshape(-1, 7)
+    assert np.allclose(m_k.sum(axis=1), m_p, rtol=1e-14, atol=0.0)
+    assert np.allclose((p.m * p.u)[daughters].reshape(-1, 7).sum(axis=1), mu_p, rtol=1e-13)
+    assert np.allclose((p.m * p.v)[daughters].reshape(-1, 7).sum(axis=1), mv_p, rtol=1e-13)
+    mass1, mom1, _ = totals(p)
+    assert abs(mass1 - mass0) <= 1e-12 * mass0
+    assert np.all(np.abs(mom1 - mom0) <= 1e-12 * scale)
+    # the pattern: centre at the parent, six at 0.4 h_p, the first along the velocity
+    dx = p.x[daughters].reshape(-1, 7) - x_p[:, None]
+    dy = p.y[daughters].reshape(-1, 7) - y_p[:, None]
+    assert np.allclose(dx[:, 0], 0.0) and np.allclose(dy[:, 0], 0.0)
+    assert np.allclose(np.hypot(dx[:, 1:], dy[:, 1:]), 0.4 * h_p[:, None], rtol=1e-12)
+    assert np.allclose(np.arctan2(dy[:, 1], dx[:, 1]), heading, atol=1e-12)
+    assert np.allclose(p.h[daughters].reshape(-1, 7), 0.9 * h_p[:, None], rtol=1e-14)
+    assert np.all(p.level[daughters] == 1)
+
+
+def test_split_keeps_the_depth_of_uniform_water():
+    """A split patch and a single split particle: SPH depth at the daughters within 2 %."""
+    for centre, radius in ((20.5, 0.1), (20.0, 6.0)):
+        model = model_on(flat, (0, 40), (0, 40), 1.0, 1.0, 1.0)
+        p = model.particles
+        parents = np.flatnonzero(np.hypot(p.x - centre, p.y - centre) < radius)
+        Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0).execute(
+            model, parents, [], [])
+        solve_in_place(model)
+        born = p.level > 0
+        assert born.sum() == 7 * parents.size
+        d = shepard_depth(model, p.x[born], p.y[born])
+        assert np.all(np.abs(d - 1.0) < 0.02), (radius, d.min(), d.max())
+
+
+def test_no_split_across_a_wall_or_below_d_min_or_beyond_max_level():
+    terrain = Terrain.from_function(flat, (0, 20), (0, 20), 1.0)
+    x, y = lattice(0.0, 20.0, 0.0, 20.0, 1.0)
+    wall_x = 10.3  # particles at x = 9.5 and 10.5 sit 0.8 and 0.2 m from the wall
+    d = np.where(y < 10.0, 1.0, 0.005)  # the north half is thinner than d_min = 0.01 m
+    p = particles_with_depth(x, y, d, 1.0, 1.3)
+    model = FloodModel(terrain, p, Numerics(spacing=1.0, kappa=1.3),
+                       walls=[np.array([[wall_x, 0.0], [wall_x, 20.0]])])
+    p = model.particles
+    refiner = Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05, max_level=1), 1.0)
+    parents = refiner.split_candidates(model)
+    hexagon = refine.EPS * p.h[parents]
+    assert np.all(np.abs(p.x[parents] - wall_x) > hexagon)
+    assert np.any((np.abs(p.x - wall_x) < 0.3) & (p.y < 10.0))  # left whole by the wall
+    assert np.all(p.rho[parents] >= RHO_WATER * 0.01)
+    refiner.execute(model, parents, [], [])
+    p = model.particles
+    on_west = p.x[p.level > 0] < wall_x
+    parent_west = np.repeat(np.asarray(on_west[::7]), 7)
+    assert np.array_equal(on_west, parent_west)  # every family on its parent's side
+    assert refiner.split_candidates(model).size == 0  # daughters are at max_level
+
+
+# -- coalescing ----------------------------------------------------------------------------------
+def test_merged_h_satisfies_the_kernel_identity():
+    """m_M W(0, h_M) = m_a W(r_a, h_a) + m_b W(r_b, h_b) with the model's own kernel."""
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        m_a, m_b = rng.uniform(10.0, 1000.0, 2)
+        h_a, h_b = rng.uniform(0.5, 3.0, 2)
+        r = rng.uniform(0.0, min(h_a, h_b))
+        r_a, r_b = r * m_b / (m_a + m_b), r * m_a / (m_a + m_b)
+        h_m = refine.merged_h(m_a, m_b, r_a, r_b, h_a, h_b)
+        s = m_a * w_cubic(r_a, h_a) + m_b * w_cubic(r_b, h_b)
+        assert (m_a + m_b) * w_cubic(0.0, h_m) == pytest.approx(s, rel=1e-12)
+        # PySPH's FindMergeable constant (7 pi / 10 in place of 10 / (7 pi)) misses it
+        h_pysph = math.sqrt(7.0 * math.pi / 10.0 * (m_a + m_b) / s)
+        assert h_pysph / h_m == pytest.approx(7.0 * math.pi / 10.0, rel=1e-12)
+    assert SIGMA_2D == pytest.approx(10.0 / (7.0 * math.pi))
+    # two coincident equal particles merge into one with the same density
+    assert refine.merged_h(5.0, 5.0, 0.0, 0.0, 1.5, 1.5) == pytest.approx(1.5, rel=1e-14)
+
+
+def test_each_merge_conserves_mass_and_momentum():
+    model = jittered_pond(1.0, u=lambda x, y: 0.3 + 0.01 * y, v=lambda x, y: 0.1 - 0.01 * x)
+    p = model.particles
+    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0), 1.0)
+    a, b = refiner.merge_pairs(model)
+    assert a.size > 50
+    assert len(set(a) | set(b)) == 2 * a.size  # each particle in one pair at most
+    pair_m = p.m[a] + p.m[b]
+    pair_mu = (p.m * p.u)[a] + (p.m * p.u)[b]
+    pair_mv = (p.m * p.v)[a] + (p.m * p.v)[b]
+    mass0, mom0, scale = totals(p)
+    assert refiner.execute(model, [], a, b) == (0, a.size)
+    merged = slice(p.n - a.size, p.n)
+    assert np.allclose(p.m[merged], pair_m, rtol=1e-15, atol=0.0)
+    assert np.allclose((p.m * p.u)[merged], pair_mu, rtol=1e-13)
+    assert np.allclose((p.m * p.v)[merged], pair_mv, rtol=1e-13)
+    mass1, mom1, _ = totals(p)
+    assert abs(mass1 - mass0) <= 1e-12 * mass0
+    assert np.all(np.abs(mom1 - mom0) <= 1e-12 * scale)
+
+
+def test_merge_keeps_the_depth_at_the_merged_position():
+    """One merge at a time in water with a depth gradient: depth within 5 % of before."""
+    def depth(x, y):
+        return 1.0 + 0.002 * x
+
+    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0), 1.0)
+    model = jittered_pond(depth)
+    a, b = refiner.merge_pairs(model)
+    p = model.particles
+    w = p.m[a] / (p.m[a] + p.m[b])
+    xm, ym = w * p.x[a] + (1 - w) * p.x[b], w * p.y[a] + (1 - w) * p.y[b]
+    inner = np.flatnonzero((np.abs(xm - 15.0) < 9.0) & (np.abs(ym - 15.0) < 9.0))[:8]
+    for k in inner:
+        model = jittered_pond(depth)
+        before = shepard_depth(model, xm[k:k + 1], ym[k:k + 1])[0]
+        refiner.execute(model, [], a[k:k + 1], b[k:k + 1])
+        solve_in_place(model)
+        p = model.particles
+        merged = np.argmax(p.m)
+        assert (p.x[merged], p.y[merged]) == pytest.approx((xm[k], ym[k]), abs=1e-9)
+        assert abs(p.rho[merged] / RHO_WATER / before - 1.0) < 0.05
+        assert abs(shepard_depth(model, xm[k:k + 1], ym[k:k + 1])[0] / before - 1.0) < 0.05
+
+
+def test_no_merge_near_walls_across_jumps_or_of_newborns():
+    model = jittered_pond(lambda x, y: np.where(x < 15.0, 1.0, 0.7))
+    p = model.particles
+    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0), 1.0)
+    a, b = refiner.merge_pairs(model)
+    protected = model.protected()
+    assert not protected[a].any() and not protected[b].any()
+    assert protected.any()
+    d_a, d_b = p.rho[a], p.rho[b]
+    assert np.all(np.abs(d_a - d_b) <= 0.2 * np.maximum(d_a, d_b))
+    patient = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=10), 1.0)
+    assert patient.merge_pairs(model)[0].size == 0  # all born at step 0, now step 0
+
+
+def kinetic_energy(p):
+    return float(np.sum(0.5 * p.m * (p.u**2 + p.v**2)))
+
+
+@pytest.fixture(scope="module")
+def pond_after_split_and_merge():
+    """A 1 m deep still pond: a patch split, its daughters merged back over 30 steps, then
+    150 more steps (20 s). Returns (model, merges, max speed and kinetic energy [J] at the
+    end of the merging)."""
+    model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
+    p = model.particles
+    splitter = Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0)
+    splitter.execute(model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
+    merger = Refiner(Refinement(area_max=3.0, area_min=0.3, no_merge_steps=0), 1.0)
+    merges = 0
+    for _ in range(30):
+        model.step()
+        merges += merger.execute(model, [], *merger.merge_pairs(model))[1]
+    speed0, energy0 = np.hypot(p.u, p.v).max(), kinetic_energy(p)
+    for _ in range(150):
+        model.step()
+    return model, merges, speed0, energy0
+
+
+def test_split_then_merge_in_still_water_stays_a_still_pond(pond_after_split_and_merge):
+    """The disturbance of split + merge decays instead of growing; depth stays within 2 %."""
+    model, merges, speed0, energy0 = pond_after_split_and_merge
+    p = model.particles
+    assert merges > 40
+    assert np.hypot(p.u, p.v).max() < speed0
+    assert kinetic_energy(p) < 0.75 * energy0
+    assert np.all(np.abs(model.depth() - 1.0) < 0.02)
+
+
+@pytest.mark.xfail(strict=True, reason="measured 7-10 cm/s just after split + merge in a 1 m "
+                   "deep pond (1 m spacing), decaying slowly (3-5 cm/s after 20 s): the hexagon "
+                   "pattern is not an SPH equilibrium and nothing but the stabilisation damps "
+                   "the relaxation")
+def test_split_then_merge_in_still_water_no_spurious_velocity_above_1mm_s(
+        pond_after_split_and_merge):
+    model = pond_after_split_and_merge[0]
+    assert np.hypot(model.particles.u, model.particles.v).max() < 1e-3
+
+
+# -- in a run ------------------------------------------------------------------------------------
+def ritter(dx, refinement=None):
+    """The verification dam break (d0 = 10 m, dam at x = 1000 m, t = 50 s) with a refiner.
+
+    Returns (L1 relative error, front error [m], particle-steps, mass error, counters).
+    """
+    d0, t_end = 10.0, 50.0
+    model = cases._lattice_model(flat, (0, 2000), (0, 100), 10.0,
+                                 lambda x, y: np.where(x < 1000, d0, 0.0), dx, 1.3)
+    if refinement is not None:
+        model.refiner = Refiner(refinement, dx)
+    mass0 = model.particles.m.sum()
+    _, particle_steps, _ = cases._run(model, t_end)
+    xq = np.arange(0.5, 2000, 1.0)
+    d = cases._channel_profile(model, xq)
+    d_ex, _ = exact.ritter(xq, t_end, d0, x_dam=1000.0)
+    front = exact.front_position(xq, d, 0.1) - exact.front_position(xq, d_ex, 0.1)
+    mass_err = abs(model.particles.m.sum() - mass0) / mass0
+    return exact.l1_relative(d, d_ex), front, particle_steps, mass_err, model.counters
+
+
+def test_splitting_improves_a_coarse_dam_break():
+    l1_plain, front_plain, _, _, _ = ritter(20.0)
+    l1, front, _, mass_err, counters = ritter(20.0, Refinement())
+    assert counters["splits"] > 0
+    assert counters["particles_max"] >= 250 + 6 * counters["splits"] - 7 * counters["merges"]
+    assert mass_err < 1e-12
+    assert l1 < 0.75 * l1_plain
+    assert abs(front) < abs(front_plain)
+
+
+@pytest.mark.slow
+def test_refined_dam_break_matches_the_fine_uniform_run_at_a_third_of_the_cost():
+    """Coarse 10 m start with one level of splitting against a uniform run at the daughters'
+    mass-equivalent spacing 10 / sqrt(7) m."""
+    fine = 10.0 / math.sqrt(7.0)
+    l1_fine, _, steps_fine, _, _ = ritter(fine)
+    l1, _, steps, mass_err, counters = ritter(10.0, Refinement(max_level=1))
+    assert counters["splits"] > 0 and mass_err < 1e-12
+    assert l1 <= 1.2 * l1_fine
+    assert steps <= steps_fine / 3
