@@ -310,7 +310,8 @@ def test_malpasset_sea_as_sink_two_steps(tmp_path):
     # V_domain + V_out = V_0 closes.
     run = json.loads((tmp_path / "sink" / "run" / "run.json").read_text())
     assert run["volume_initial_m3"] == pytest.approx(48.9e6, rel=0.01)
-    assert cost["particles_final"] == cost["particles_initial"] < 6_000
+    # splitting may add particles at the thin margins from the first step
+    assert cost["particles_initial"] <= cost["particles_final"] < 6_100
     assert cost["volume_out_m3"] == 0.0 and cost["mass_error_rel"] < 1e-9
     with rasterio.open(tmp_path / "sink" / "run" / "max_depth.tif") as d:
         depth = d.read(1)
