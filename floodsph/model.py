@@ -115,8 +115,7 @@ class FloodModel:
         openings = [b.opening for b in self.boundaries if hasattr(b, "opening")]
         self.seg = cut_openings(np.concatenate(segs), openings, 1e-6 * numerics.spacing)
         self.wall_index = wallmod.WallIndex(
-            self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=8.0 * h0,
-            margin=8.0 * h0)
+            self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=2.0 * h0)
         self.t = 0.0
         self.steps = 0
         self.volume_in = 0.0
@@ -124,6 +123,7 @@ class FloodModel:
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
                          "wall_reflections": 0, "density_unconverged": 0}
         self.bed = np.empty((0, 7))
+        self.blocked = np.empty(0, dtype=np.bool_)
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
         self._remove_outside()
@@ -241,14 +241,24 @@ class FloodModel:
         if nl is not None and nl.still_valid(p.x, p.y, p.h):
             return
         self.nl = NeighbourList(p.x, p.y, p.h, skin=self.numerics.neighbour_skin)
-        self.wstart, self.wseg = self.wall_index.near_lists(
-            p.x, p.y, p.h, self.nl.start, self.nl.nbr, self.nl.reach)
+        self.walls_near = self.wall_index.near_lists(p.x, p.y, p.h, self.nl.start, self.nl.nbr,
+                                                     self.nl.reach)
+        self.wstart, self.wseg = self.walls_near[:2]
+
+    def _blocked_pairs(self) -> None:
+        """Flag the listed pairs that a wall separates, at the current positions."""
+        p = self.particles
+        if self.blocked.shape[0] != self.nl.nbr.shape[0]:
+            self.blocked = np.empty(self.nl.nbr.shape[0], dtype=np.bool_)
+        wallmod.blocked_pairs(p.x, p.y, self.nl.start, self.nl.nbr, self.wstart, self.wseg,
+                              self.seg, self.blocked)
 
     def _solve_density(self) -> None:
         num = self.numerics
         p = self.particles
         for _ in range(3):
-            _, bad = density.solve_density(p, self.nl, self.wstart, self.wseg, self.seg,
+            self._blocked_pairs()
+            _, bad = density.solve_density(p, self.nl, self.blocked, self.walls_near, self.seg,
                                            tol=num.density_tol, max_iter=num.density_max_iter,
                                            h_ratio=num.h_ratio)
             if self.nl.still_valid(p.x, p.y, p.h):
@@ -263,8 +273,8 @@ class FloodModel:
             self.bed = np.empty((p.n, 7))
         bedmod.sample_bed(p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         forces.internal_acceleration(p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, self.nl.start,
-                                     self.nl.nbr, self.wstart, self.wseg, self.seg, self.scheme,
-                                     p.ax, p.ay, p.divv)
+                                     self.nl.nbr, self.blocked, *self.walls_near, self.seg,
+                                     self.scheme, p.ax, p.ay, p.divv)
         forces.add_bed_acceleration(p.u, p.v, self.bed, self.numerics.max_slope, p.ax, p.ay)
 
 

@@ -200,7 +200,11 @@ def build_model(scenario: Scenario, inputs):
         walls=inputs.walls,
         closed_edges=scenario.terrain.edges is Edges.CLOSED,
         boundaries=open_boundaries(scenario, inputs, numerics),
-        refiner=Refiner.from_settings(num.refinement.value, inputs.spacing_m),
+        refiner=Refiner.from_settings(num.refinement.value, inputs.spacing_m,
+                                      area_max=num.refine_area_max,
+                                      area_min=num.refine_area_min,
+                                      d_min=num.refine_d_min_m,
+                                      max_level=num.refine_max_level),
     )
 
 

@@ -145,6 +145,8 @@ class NumericsConfig:
     """``[numerics]``: the solver's tunables (see ``floodsph.model.Numerics``).
 
     ``particle_spacing_m = None`` means the DEM cell size; ``threads = 0`` means all cores.
+    ``refine_*`` are the splitting and coalescing thresholds of ``floodsph.refinement``
+    (areas in units of particle_spacing_m^2, the split depth floor in m, the generations).
     """
 
     particle_spacing_m: float | None = None
@@ -156,6 +158,10 @@ class NumericsConfig:
     density_tol: float = 1e-3
     friction_depth_floor_m: float = 0.01
     max_slope: float = 1.0
+    refine_area_max: float = 2.0
+    refine_area_min: float = 0.2
+    refine_d_min_m: float = 0.01
+    refine_max_level: int = 3
 
 
 @dataclass(frozen=True)
@@ -443,7 +449,7 @@ def _numerics(r: Reader, data: dict) -> NumericsConfig:
     keys = tuple(f.name for f in fields(NumericsConfig))
     t = r.sub_table(data, "", p, keys)
     d = NumericsConfig()
-    return NumericsConfig(
+    out = NumericsConfig(
         particle_spacing_m=r.number(t, p, "particle_spacing_m", None, gt=0.0),
         cfl=r.number(t, p, "cfl", d.cfl, gt=0.0, le=1.0),
         refinement=r.choice(t, p, "refinement", Refinement, d.refinement),
@@ -455,7 +461,17 @@ def _numerics(r: Reader, data: dict) -> NumericsConfig:
             t, p, "friction_depth_floor_m", d.friction_depth_floor_m, gt=0.0
         ),
         max_slope=r.number(t, p, "max_slope", d.max_slope, gt=0.0),
+        refine_area_max=r.number(t, p, "refine_area_max", d.refine_area_max, gt=0.0),
+        refine_area_min=r.number(t, p, "refine_area_min", d.refine_area_min, gt=0.0),
+        refine_d_min_m=r.number(t, p, "refine_d_min_m", d.refine_d_min_m, ge=0.0),
+        refine_max_level=r.integer(t, p, "refine_max_level", d.refine_max_level, ge=0),
     )
+    if not out.refine_area_min < out.refine_area_max / 2.0:
+        raise r.fail(join(p, "refine_area_min"),
+                     f"must be below refine_area_max / 2 = {out.refine_area_max / 2.0:g} so "
+                     f"that a merged pair is not split again at once; got "
+                     f"{out.refine_area_min:g}")
+    return out
 
 
 def _output(r: Reader, data: dict) -> OutputConfig:

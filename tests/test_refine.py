@@ -59,8 +59,8 @@ def solve_in_place(model):
 
 # -- settings ------------------------------------------------------------------------------------
 def test_settings_reject_thresholds_without_hysteresis():
-    with pytest.raises(InputError, match=r"area_min < area_max / 7.*area_min=0\.5, area_max=2"):
-        Refinement(area_max=2.0, area_min=0.5)
+    with pytest.raises(InputError, match=r"area_min < area_max / 2.*area_min=1\.5, area_max=2"):
+        Refinement(area_max=2.0, area_min=1.5)
     with pytest.raises(InputError, match=r"numerics.refinement: 'coarsen' is not one of"):
         Refinement(mode="coarsen")
     assert Refiner.from_settings("none", 10.0) is None
@@ -160,7 +160,8 @@ def test_merged_h_satisfies_the_kernel_identity():
 def test_each_merge_conserves_mass_and_momentum():
     model = jittered_pond(1.0, u=lambda x, y: 0.3 + 0.01 * y, v=lambda x, y: 0.1 - 0.01 * x)
     p = model.particles
-    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0), 1.0)
+    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0, depth_jump=0.2),
+                      1.0)
     a, b = refiner.merge_pairs(model)
     assert a.size > 50
     assert len(set(a) | set(b)) == 2 * a.size  # each particle in one pair at most
@@ -205,7 +206,8 @@ def test_merge_keeps_the_depth_at_the_merged_position():
 def test_no_merge_near_walls_across_jumps_or_of_newborns():
     model = jittered_pond(lambda x, y: np.where(x < 15.0, 1.0, 0.7))
     p = model.particles
-    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0), 1.0)
+    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0, depth_jump=0.2),
+                      1.0)
     a, b = refiner.merge_pairs(model)
     protected = model.protected()
     assert not protected[a].any() and not protected[b].any()

@@ -87,6 +87,11 @@ POLY = "[[0, 0], [10, 0], [10, 10]]"
         (('refinement = "none"', 'refinement = "lots"'),
          "numerics.refinement: expected one of 'split+coalesce', 'split', 'none', "
          "got string 'lots'"),
+        (('refinement = "none"', 'refinement = "split"\nrefine_area_min = 1.5'),
+         "numerics.refine_area_min: must be below refine_area_max / 2 = 1 so that a merged "
+         "pair is not split again at once; got 1.5"),
+        (('refinement = "none"', "refine_max_level = -1"),
+         "numerics.refine_max_level: must be >= 0, got -1"),
         (('edges = "closed"', 'edges = "sometimes"'),
          "terrain.edges: expected one of 'open', 'closed', got string 'sometimes'"),
         (("resolution_m = 10.0", "wet_threshold_m = -0.1"),
@@ -178,3 +183,21 @@ def test_hydrograph_is_read_at_load(write_scenario, tmp_path):
     message = error_of(write_scenario, text)
     assert message.startswith(f"{tmp_path / 'scenario.toml'}: inflows[0].hydrograph: ")
     assert "line 4" in message and "times must increase strictly" in message
+
+
+def test_refinement_thresholds_reach_the_refiner(write_scenario):
+    from floodsph.inputs import prepare_inputs
+    from floodsph.run import build_model
+
+    text = BASE_SCENARIO.replace(
+        'refinement = "none"',
+        'refinement = "split+coalesce"\nrefine_area_max = 3.0\nrefine_area_min = 0.5\n'
+        "refine_d_min_m = 0.05\nrefine_max_level = 2")
+    scenario = load_scenario(write_scenario(text))
+    inputs = prepare_inputs(scenario)
+    refiner = build_model(scenario, inputs).refiner
+    spacing = inputs.spacing_m
+    assert refiner.area_max == pytest.approx(3.0 * spacing**2)
+    assert refiner.area_min == pytest.approx(0.5 * spacing**2)
+    assert (refiner.settings.d_min, refiner.settings.max_level) == (0.05, 2)
+    assert refiner.settings.coalesces

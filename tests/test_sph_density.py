@@ -25,7 +25,7 @@ def test_newton_converges_in_few_iterations_from_a_perturbed_guess():
     model = FloodModel(terrain, p, Numerics(spacing=2.0, kappa=1.3))
     p.rho[:] *= 1.05  # a guess 5 % off, as after a long step
     p.h[:] = p.h0 * np.sqrt(p.rho0 / p.rho)
-    iters, bad = density.solve_density(p, model.nl, model.wstart, model.wseg, model.seg,
+    iters, bad = density.solve_density(p, model.nl, model.blocked, model.walls_near, model.seg,
                                        tol=1e-6)
     assert bad == 0
     assert iters <= 5

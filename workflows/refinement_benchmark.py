@@ -17,7 +17,7 @@ markdown tables. Wall times depend on the machine's load: compare the ratios wit
 
     python workflows/refinement_benchmark.py [--out results/refinement_benchmark]
         [--cases valley malpasset] [--modes none split split+coalesce] [--max-steps N]
-        [--malpasset-spacing 40] [--malpasset-end-time 1000]
+        [--malpasset-spacing 40] [--malpasset-end-time 1000] [--set refine_area_min=0.5 ...]
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ class StepCounter:
 
 
 def scenario_for(case: str, mode: str, out: Path, spacing: float | None = None,
-                 end_time: float | None = None):
+                 end_time: float | None = None, settings: dict | None = None):
     """The case's scenario with ``mode``, its end time and ``out`` as the run folder.
 
     ``spacing`` [m] and ``end_time`` [s] override the scenario's particle spacing and the
@@ -79,40 +79,30 @@ def scenario_for(case: str, mode: str, out: Path, spacing: float | None = None,
         terrain=dataclasses.replace(scenario.terrain, dem=dem),
         numerics=dataclasses.replace(
             scenario.numerics, refinement=Refinement(mode),
-            particle_spacing_m=spacing or scenario.numerics.particle_spacing_m),
+            particle_spacing_m=spacing or scenario.numerics.particle_spacing_m,
+            **(settings or {})),
         output=dataclasses.replace(scenario.output, directory=out),
     )
 
 
 def run(case: str, mode: str, out: Path, max_steps: int | None,
-        spacing: float | None = None, end_time: float | None = None) -> dict | None:
-    """Run one case in one mode; return its row of the results table."""
+        spacing: float | None = None, end_time: float | None = None,
+        settings: dict | None = None) -> dict | None:
+    """Run one case in one mode; return its row of the results table.
+
+    ``settings`` are ``[numerics]`` refinement keys (``refine_area_max``, ...) to override.
+    """
     import floodsph.run as runner
-    from floodsph.refinement import Refiner
     from floodsph.schedules import IterationInterval
 
-    scenario = scenario_for(case, mode, out, spacing, end_time)
+    scenario = scenario_for(case, mode, out, spacing, end_time, settings)
     if scenario is None:
         return None
-    build_model = runner.build_model
-
-    def build_with_refiner(scen, inputs):
-        # Until run.build_model wires numerics.refinement itself, attach the refiner here.
-        model = build_model(scen, inputs)
-        if model.refiner is None:
-            model.refiner = Refiner.from_settings(mode, inputs.spacing_m)
-        return model
-
     counter = StepCounter()
-    runner.build_model = build_with_refiner
-    try:
-        t0 = time.perf_counter()
-        manifest = runner.run_scenario(scenario, out, max_steps=max_steps, progress=False,
-                                       overwrite=True,
-                                       callbacks=[(counter, IterationInterval(1))])
-        wall = time.perf_counter() - t0
-    finally:
-        runner.build_model = build_model
+    t0 = time.perf_counter()
+    manifest = runner.run_scenario(scenario, out, max_steps=max_steps, progress=False,
+                                   overwrite=True, callbacks=[(counter, IterationInterval(1))])
+    wall = time.perf_counter() - t0
     row = {"case": case, "mode": mode, "spacing_m": manifest["particle_spacing_m"],
            "wall_s": round(wall, 1),
            "sim_time_s": manifest["sim_time_s"], "steps": manifest["steps"],
@@ -163,8 +153,12 @@ def main() -> None:
                     help="particle spacing [m] for Malpasset (default: the scenario's 20 m)")
     ap.add_argument("--malpasset-end-time", type=float, default=None,
                     help="simulated time [s] for Malpasset (default 1000 s)")
+    ap.add_argument("--set", nargs="+", default=[], metavar="KEY=VALUE",
+                    help="[numerics] refinement keys, e.g. refine_area_min=0.5")
     args = ap.parse_args()
     out = args.out.resolve()
+    settings = {k: float(v) if "." in v else int(v)
+                for k, v in (item.split("=", 1) for item in args.set)}
     rows, pairs = [], []
     for case in args.cases:
         done = []
@@ -172,7 +166,7 @@ def main() -> None:
             mp = case == "malpasset"
             row = run(case, mode, out / case / mode, args.max_steps,
                       args.malpasset_spacing if mp else None,
-                      args.malpasset_end_time if mp else None)
+                      args.malpasset_end_time if mp else None, settings)
             if row is not None:
                 rows.append(row)
                 done.append(mode)

@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import w_cubic, w_dwdr_cubic
-from floodsph.sph.walls import blocked, corner_image, wall_image
+from floodsph.sph.walls import corner_image, wall_image
 
 
 @njit(inline="always", cache=True)
@@ -54,59 +54,57 @@ def _corner(i, j, x, y, m, hi, seg, s1, s2):
 
 
 @njit(inline="always", cache=True)
-def summation(i, hi, x, y, m, nstart, nbr, wstart, wseg, seg):
+def summation(i, hi, x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair, seg):
     """Density summation (1) and alpha_i of particle i at smoothing length ``hi``.
 
     Returns (sum_j m_j W(r_ij, h_i), alpha_i), self and mirror images included; listed
-    neighbours beyond the support 2 h_i are skipped (W = 0 there).
+    neighbours beyond the support 2 h_i are skipped (W = 0 there). Pairs flagged in
+    ``blocked`` (:func:`floodsph.sph.walls.blocked_pairs`) are left out with their images.
+    Images are summed segment by segment, each segment followed by the corners it opens
+    (``cpair`` lists them in that order), so the sum does not depend on list order.
     """
     xi = x[i]
     yi = y[i]
     rsum = m[i] * w_cubic(0.0, hi)
     alpha = 0.0
-    near_wall = wstart[i + 1] > wstart[i]
     support2 = 4.0 * hi * hi
     for q in range(nstart[i], nstart[i + 1]):
         j = nbr[q]
         rx = xi - x[j]
         ry = yi - y[j]
-        if rx * rx + ry * ry >= support2:
-            continue
-        if near_wall and blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
+        if rx * rx + ry * ry >= support2 or blocked[q]:
             continue
         w, a = _pair(rx, ry, m[j], hi)
         rsum += w
         alpha -= a
+    c = cstart[i]
     for k in range(wstart[i], wstart[i + 1]):
         s = wseg[k]
         w, a = _image(i, i, x, y, m, hi, seg, s)
         rsum += w
         alpha -= a
         for q in range(nstart[i], nstart[i + 1]):
-            j = nbr[q]
-            if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
-                continue
-            w, a = _image(i, j, x, y, m, hi, seg, s)
-            rsum += w
-            alpha -= a
-        for k2 in range(k + 1, wstart[i + 1]):
-            s2 = wseg[k2]
+            if not blocked[q]:
+                w, a = _image(i, nbr[q], x, y, m, hi, seg, s)
+                rsum += w
+                alpha -= a
+        while c < cstart[i + 1] and cpair[c, 0] == s:
+            s2 = cpair[c, 1]
             w, a = _corner(i, i, x, y, m, hi, seg, s, s2)
             rsum += w
             alpha -= a
             for q in range(nstart[i], nstart[i + 1]):
-                j = nbr[q]
-                if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
-                    continue
-                w, a = _corner(i, j, x, y, m, hi, seg, s, s2)
-                rsum += w
-                alpha -= a
+                if not blocked[q]:
+                    w, a = _corner(i, nbr[q], x, y, m, hi, seg, s, s2)
+                    rsum += w
+                    alpha -= a
+            c += 1
     return rsum, alpha
 
 
 @njit(parallel=True, cache=True)
-def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, wstart, wseg, seg, tol, max_iter,
-          h_ratio, iters):
+def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
+          seg, tol, max_iter, h_ratio, iters):
     """Newton-Raphson solve (1)-(3) of every particle, in place (gather form).
 
     Only h_i changes the summation of particle i, so each particle iterates on its own to
@@ -118,7 +116,8 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, wstart, wseg, seg, tol,
         it = 0
         done = False
         while it < max_iter:
-            s, a = summation(i, h[i], x, y, m, nstart, nbr, wstart, wseg, seg)
+            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
+                             seg)
             alpha[i] = a
             it += 1
             res = rho[i] - s
@@ -134,7 +133,8 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, wstart, wseg, seg, tol,
         if done:
             iters[i] = it
         else:
-            s, a = summation(i, h[i], x, y, m, nstart, nbr, wstart, wseg, seg)
+            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
+                             seg)
             rho[i] = s
             alpha[i] = a
             iters[i] = -it
@@ -149,15 +149,18 @@ def predict(rho, h, divv, dt):
         h[i] *= 1.0 / math.sqrt(f)
 
 
-def solve_density(p, nl, wstart, wseg, seg, tol=1e-3, max_iter=20, h_ratio=10.0):
+def solve_density(p, nl, blocked, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0):
     """Solve (1)-(3) for all particles of ``p`` in place; return (iterations, unconverged).
 
-    ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList.
+    ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList;
+    ``blocked`` its pairs separated by a wall (:func:`floodsph.sph.walls.blocked_pairs`);
+    ``walls`` the near-wall lists (wstart, wseg, cstart, cpair) of
+    :meth:`floodsph.sph.walls.WallIndex.near_lists`; ``seg`` the wall segments.
     On return every particle has rho, h and alpha consistent with its neighbours to ``tol``,
     except the returned number of unconverged ones, which take the plain summation.
     ``iterations`` is the largest number of summations any particle needed.
     """
     iters = np.zeros(p.n, dtype=np.int64)
-    solve(p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, wstart, wseg, seg,
+    solve(p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked, *walls, seg,
           tol, max_iter, h_ratio, iters)
     return int(np.abs(iters).max(initial=0)), int((iters < 0).sum())

@@ -36,7 +36,7 @@ from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.kernels import dwdr_over_r_cubic
-from floodsph.sph.walls import blocked, corner_image, mirror, wall_image
+from floodsph.sph.walls import corner_image, mirror, wall_image
 
 LAX_FRIEDRICHS = 0
 RIEMANN = 1
@@ -110,11 +110,15 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme):
 
 
 @njit(parallel=True, cache=True)
-def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, wstart, wseg, seg, scheme,
-                          ax, ay, divv):
+def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wstart, wseg, cstart,
+                          cpair, seg, scheme, ax, ay, divv):
     """a^int and div v of every particle (gather form), mirror images included.
 
-    Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there).
+    Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
+    flagged in ``blocked`` (:func:`floodsph.sph.walls.blocked_pairs`) are left out with
+    their images. The wall lists (wstart, wseg, cstart, cpair) are those of
+    :meth:`floodsph.sph.walls.WallIndex.near_lists`; images are summed segment by segment,
+    each followed by the corners it opens, as in the density summation.
     """
     coef = np.empty((x.shape[0], 3))
     pair_coefficients(rho, alpha, h, coef)
@@ -125,53 +129,56 @@ def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, wstart, wse
         fx = 0.0
         fy = 0.0
         fd = 0.0
-        near_wall = wstart[i + 1] > wstart[i]
         for q in range(nstart[i], nstart[i + 1]):
             j = nbr[q]
             rx = xi - x[j]
             ry = yi - y[j]
             hm = 2.0 * max(hi, h[j])
-            if rx * rx + ry * ry >= hm * hm:
-                continue
-            if near_wall and blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
+            if rx * rx + ry * ry >= hm * hm or blocked[q]:
                 continue
             gx, gy, gd = pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m, rho, h, coef,
                                     scheme)
             fx -= gx
             fy -= gy
             fd -= gd
+        c = cstart[i]
         for w in range(wstart[i], wstart[i + 1]):
             s = wseg[w]
-            gx, gy, gd = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
-            fx -= gx
-            fy -= gy
-            fd -= gd
-            for q in range(nstart[i], nstart[i + 1]):
-                j = nbr[q]
-                if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
-                    continue
-                gx, gy, gd = _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme)
-                fx -= gx
-                fy -= gy
-                fd -= gd
-            for w2 in range(w + 1, wstart[i + 1]):
-                s2 = wseg[w2]
-                gx, gy, gd = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-                fx -= gx
-                fy -= gy
-                fd -= gd
-                for q in range(nstart[i], nstart[i + 1]):
-                    j = nbr[q]
-                    if blocked(xi, yi, x[j], y[j], wstart, wseg, seg, i):
-                        continue
-                    gx, gy, gd = _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, s2,
-                                               scheme)
-                    fx -= gx
-                    fy -= gy
-                    fd -= gd
+            fx, fy, fd = _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v, m,
+                                          rho, h, coef, seg, s, -1, scheme)
+            while c < cstart[i + 1] and cpair[c, 0] == s:
+                fx, fy, fd = _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v,
+                                              m, rho, h, coef, seg, s, cpair[c, 1], scheme)
+                c += 1
         ax[i] = fx
         ay[i] = fy
         divv[i] = 2.0 * fd / alpha[i]
+
+
+@njit(inline="always", cache=True)
+def _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, seg, s, s2,
+                     scheme):
+    """Subtract from (fx, fy, fd) the pair terms on particle i of the images of i and of its
+    unblocked neighbours about segment s (s2 < 0) or about the corner of s and s2."""
+    if s2 < 0:
+        gx, gy, gd = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
+    else:
+        gx, gy, gd = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
+    fx -= gx
+    fy -= gy
+    fd -= gd
+    for q in range(nstart[i], nstart[i + 1]):
+        if blocked[q]:
+            continue
+        if s2 < 0:
+            gx, gy, gd = _image_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, scheme)
+        else:
+            gx, gy, gd = _corner_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, s2,
+                                       scheme)
+        fx -= gx
+        fy -= gy
+        fd -= gd
+    return fx, fy, fd
 
 
 @njit(inline="always", cache=True)

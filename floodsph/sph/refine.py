@@ -45,7 +45,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import SIGMA_2D, w_cubic
-from floodsph.sph.walls import crosses
+from floodsph.sph.walls import crosses, first_visit, query_box
 
 VERTEX_FRACTION = 0.136882287617319
 """Mass of each of the six hexagon daughters over the parent's mass [V12-split]."""
@@ -92,43 +92,50 @@ def daughters(xp, yp, up, vp, mp, hp, eps, still, x, y, m):
 
 
 @njit(parallel=True, cache=True)
-def daughters_clear(xp, yp, x, y, seg, bstart, items, bxmin, bymin, bucket, nbx, nby, margin,
-                    out):
+def daughters_clear(xp, yp, x, y, seg, bstart, items, xmin, ymin, bucket, nbx, nby, out):
     """out[k] = True when no wall segment separates parent k from any of its 7 daughters.
 
-    The segments come from the bucket of ``floodsph.sph.walls.WallIndex`` that holds the
-    parent, which lists every segment within ``margin`` of it; a hexagon wider than the
-    margin is checked against all segments.
+    The segments come from the buckets of ``floodsph.sph.walls.WallIndex`` (its ``start``,
+    ``items`` and ``grid``) that the square around the hexagon overlaps.
     """
     for k in prange(xp.shape[0]):
         base = DAUGHTERS * k
         radius = math.hypot(x[base + 1] - xp[k], y[base + 1] - yp[k])
-        bx = min(max(int((xp[k] - bxmin) // bucket), 0), nbx - 1)
-        by = min(max(int((yp[k] - bymin) // bucket), 0), nby - 1)
-        b = by * nbx + bx
-        local = radius <= margin
-        count = bstart[b + 1] - bstart[b] if local else seg.shape[0]
+        bx0, bx1, by0, by1 = query_box(xp[k] - radius, yp[k] - radius, xp[k] + radius,
+                                       yp[k] + radius, xmin, ymin, bucket, nbx, nby)
         ok = True
-        for q in range(count):
-            s = items[bstart[b] + q] if local else q
-            for j in range(1, DAUGHTERS):
-                if crosses(xp[k], yp[k], x[base + j], y[base + j], seg[s, 0], seg[s, 1],
-                           seg[s, 2], seg[s, 3]):
-                    ok = False
+        for by in range(by0, by1 + 1):
+            for bx in range(bx0, bx1 + 1):
+                b = by * nbx + bx
+                for q in range(bstart[b], bstart[b + 1]):
+                    s = items[q]
+                    if not first_visit(seg, s, bx, by, bx0, by0, xmin, ymin, bucket, nbx, nby):
+                        continue
+                    for j in range(1, DAUGHTERS):
+                        if crosses(xp[k], yp[k], x[base + j], y[base + j], seg[s, 0],
+                                   seg[s, 1], seg[s, 2], seg[s, 3]):
+                            ok = False
         out[k] = ok
 
 
 @njit(parallel=True, cache=True)
-def nearest_neighbour(x, y, nstart, nbr, out):
-    """Index of each particle's nearest neighbour in the CSR list (-1 if it has none).
+def nearest_candidate(x, y, nstart, nbr, cand, out):
+    """Index of each candidate's nearest fellow candidate in the CSR list, else -1.
 
-    Ties are broken by the lower index, so the result is deterministic.
+    Pairing mutual nearest candidates (not nearest particles of any kind) lets a small
+    particle beside a large one still find a partner, and stays conflict-free. Ties are
+    broken by the lower index, so the result is deterministic.
     """
     for i in prange(x.shape[0]):
         best = -1
         best_r2 = np.inf
+        if not cand[i]:
+            out[i] = best
+            continue
         for q in range(nstart[i], nstart[i + 1]):
             j = nbr[q]
+            if not cand[j] or j == i:
+                continue
             dx = x[j] - x[i]
             dy = y[j] - y[i]
             r2 = dx * dx + dy * dy

@@ -52,50 +52,62 @@ def box_polyline(xmin, ymin, xmax, ymax) -> np.ndarray:
 class WallIndex:
     """Static buckets of wall segments for fast near-wall queries.
 
-    Each square bucket of side ``bucket`` lists the segments whose bounding box, grown by
-    ``margin``, overlaps it; a query of radius <= margin then needs only its own bucket.
-    Queries of a larger radius scan all segments.
+    Each square bucket of side ``bucket`` lists the segments whose bounding box overlaps it
+    (buckets beyond the domain's bounds are clamped to the outermost ones). A query of any
+    radius visits the buckets its square overlaps and takes each segment in the first of them
+    that the segment and the query square share (:func:`query_box`, :func:`first_visit`), so
+    no segment is seen twice and the cost follows the walls near the point, not their total.
     """
 
-    def __init__(self, seg: np.ndarray, bounds, bucket: float, margin: float):
+    def __init__(self, seg: np.ndarray, bounds, bucket: float):
         self.seg = np.ascontiguousarray(seg, dtype=np.float64).reshape(-1, 4)
         xmin, ymin, xmax, ymax = bounds
-        self.xmin, self.ymin = float(xmin) - margin, float(ymin) - margin
+        self.xmin, self.ymin = float(xmin), float(ymin)
         self.bucket = float(bucket)
-        self.margin = float(margin)
-        self.nbx = max(1, int((xmax - xmin + 2 * margin) / bucket) + 1)
-        self.nby = max(1, int((ymax - ymin + 2 * margin) / bucket) + 1)
+        self.nbx = max(1, int((xmax - xmin) / bucket) + 1)
+        self.nby = max(1, int((ymax - ymin) / bucket) + 1)
         lists = [[] for _ in range(self.nbx * self.nby)]
         for s, (x1, y1, x2, y2) in enumerate(self.seg):
-            bx0 = int((min(x1, x2) - margin - self.xmin) // bucket)
-            bx1 = int((max(x1, x2) + margin - self.xmin) // bucket)
-            by0 = int((min(y1, y2) - margin - self.ymin) // bucket)
-            by1 = int((max(y1, y2) + margin - self.ymin) // bucket)
-            for by in range(max(by0, 0), min(by1, self.nby - 1) + 1):
-                for bx in range(max(bx0, 0), min(bx1, self.nbx - 1) + 1):
+            bx0, bx1, by0, by1 = query_box(min(x1, x2), min(y1, y2), max(x1, x2), max(y1, y2),
+                                           *self.grid)
+            for by in range(by0, by1 + 1):
+                for bx in range(bx0, bx1 + 1):
                     lists[by * self.nbx + bx].append(s)
         counts = np.array([len(v) for v in lists], dtype=np.int64)
         self.start = np.zeros(len(lists) + 1, dtype=np.int64)
         np.cumsum(counts, out=self.start[1:])
         self.items = np.array([s for v in lists for s in v], dtype=np.int64)
 
-    def near_lists(self, x, y, h, nstart, nbr, reach):
-        """CSR lists (wstart, wseg) of the segments within each particle's reach.
+    @property
+    def grid(self) -> tuple:
+        """(xmin, ymin, bucket, nbx, nby): the bucket grid, as the kernels take it."""
+        return self.xmin, self.ymin, self.bucket, self.nbx, self.nby
 
+    def near_lists(self, x, y, h, nstart, nbr, reach):
+        """CSR lists of the segments within each particle's reach, and of its wall corners.
+
+        Returns (wstart, wseg, cstart, cpair): particle i's near segments are
+        ``wseg[wstart[i]:wstart[i + 1]]``, and the pairs of them that share a vertex (the
+        corners that make double images) are the rows ``cpair[cstart[i]:cstart[i + 1]]``.
         The radius of particle i is reach * max(h_i, max_j h_j) over its neighbours j, so a
         wall between i and any neighbour is always in i's list (pair blocking is symmetric).
         """
         n = x.shape[0]
         wstart = np.zeros(n + 1, dtype=np.int64)
+        cstart = np.zeros(n + 1, dtype=np.int64)
         if self.seg.shape[0] == 0 or n == 0:
-            return wstart, np.zeros(0, dtype=np.int64)
-        args = (x, y, h, float(h.max()), nstart, nbr, reach, self.seg, self.start, self.items,
-                self.xmin, self.ymin, self.bucket, self.nbx, self.nby, self.margin)
+            return (wstart, np.zeros(0, dtype=np.int64), cstart,
+                    np.zeros((0, 2), dtype=np.int64))
+        args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items, *self.grid)
         _near_scan(*args, wstart, np.zeros(0, dtype=np.int64), False)
         np.cumsum(wstart, out=wstart)
         wseg = np.empty(wstart[-1], dtype=np.int64)
         _near_scan(*args, wstart, wseg, True)
-        return wstart, wseg
+        _corner_scan(wstart, wseg, self.seg, cstart, np.zeros((0, 2), dtype=np.int64), False)
+        np.cumsum(cstart, out=cstart)
+        cpair = np.empty((cstart[-1], 2), dtype=np.int64)
+        _corner_scan(wstart, wseg, self.seg, cstart, cpair, True)
+        return wstart, wseg, cstart, cpair
 
 
 @njit(inline="always", cache=True)
@@ -108,37 +120,98 @@ def segment_distance(px, py, x1, y1, x2, y2):
     return math.hypot(px - x1 - t * ex, py - y1 - t * ey)
 
 
+@njit(inline="always", cache=True)
+def query_box(x0, y0, x1, y1, xmin, ymin, bucket, nbx, nby):
+    """Bucket index range (bx0, bx1, by0, by1) overlapped by the box [x0, x1] x [y0, y1]."""
+    bx0 = min(max(int((x0 - xmin) // bucket), 0), nbx - 1)
+    bx1 = min(max(int((x1 - xmin) // bucket), 0), nbx - 1)
+    by0 = min(max(int((y0 - ymin) // bucket), 0), nby - 1)
+    by1 = min(max(int((y1 - ymin) // bucket), 0), nby - 1)
+    return bx0, bx1, by0, by1
+
+
+@njit(inline="always", cache=True)
+def first_visit(seg, s, bx, by, qbx0, qby0, xmin, ymin, bucket, nbx, nby):
+    """True if bucket (bx, by) is the first bucket, of a query starting at bucket
+    (qbx0, qby0), that lists segment s: the one holding the low corner of the overlap."""
+    sbx0, _, sby0, _ = query_box(min(seg[s, 0], seg[s, 2]), min(seg[s, 1], seg[s, 3]),
+                                 min(seg[s, 0], seg[s, 2]), min(seg[s, 1], seg[s, 3]),
+                                 xmin, ymin, bucket, nbx, nby)
+    return bx == max(sbx0, qbx0) and by == max(sby0, qby0)
+
+
 @njit(parallel=True, cache=True)
-def _near_scan(x, y, h, h_max, nstart, nbr, reach, seg, bstart, items, bxmin, bymin, bucket,
-               nbx, nby, margin, wstart, wseg, fill):
+def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, xmin, ymin, bucket, nbx, nby,
+               wstart, wseg, fill):
+    """Count (fill False: into wstart[i + 1]) or list (fill True, in index order) each
+    particle's segments within reach * max(h_i, max_j h_j)."""
     for i in prange(x.shape[0]):
-        bx = min(max(int((x[i] - bxmin) // bucket), 0), nbx - 1)
-        by = min(max(int((y[i] - bymin) // bucket), 0), nby - 1)
-        b = by * nbx + bx
-        if bstart[b] == bstart[b + 1] and reach * h_max <= margin:
-            continue  # no segment within the margin, and no radius beyond it: none listed
         hr = h[i]
         for k in range(nstart[i], nstart[i + 1]):
             hr = max(hr, h[nbr[k]])
         radius = reach * hr
+        bx0, bx1, by0, by1 = query_box(x[i] - radius, y[i] - radius, x[i] + radius,
+                                       y[i] + radius, xmin, ymin, bucket, nbx, nby)
         k = 0
-        if radius <= margin:
-            for q in range(bstart[b], bstart[b + 1]):
-                s = items[q]
-                dist = segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-                if dist < radius:
-                    if fill:
-                        wseg[wstart[i] + k] = s
-                    k += 1
+        for by in range(by0, by1 + 1):
+            for bx in range(bx0, bx1 + 1):
+                b = by * nbx + bx
+                for q in range(bstart[b], bstart[b + 1]):
+                    s = items[q]
+                    if not first_visit(seg, s, bx, by, bx0, by0, xmin, ymin, bucket, nbx, nby):
+                        continue
+                    if segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2],
+                                        seg[s, 3]) < radius:
+                        if fill:
+                            wseg[wstart[i] + k] = s
+                        k += 1
+        if fill:
+            _sort_run(wseg, wstart[i], wstart[i] + k)
         else:
-            for s in range(seg.shape[0]):
-                dist = segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-                if dist < radius:
+            wstart[i + 1] = k
+
+
+@njit(inline="always", cache=True)
+def _sort_run(a, lo, hi):
+    """Insertion sort of a[lo:hi] in place (a particle's few segments, in index order, so
+    that the sums over them do not depend on the bucket path that found them)."""
+    for k in range(lo + 1, hi):
+        v = a[k]
+        q = k - 1
+        while q >= lo and a[q] > v:
+            a[q + 1] = a[q]
+            q -= 1
+        a[q + 1] = v
+
+
+@njit(inline="always", cache=True)
+def share_vertex(seg, s1, s2):
+    """True if segments s1 and s2 have an end point in common (exactly)."""
+    for a in range(2):
+        for b in range(2):
+            if seg[s1, 2 * a] == seg[s2, 2 * b] and seg[s1, 2 * a + 1] == seg[s2, 2 * b + 1]:
+                return True
+    return False
+
+
+@njit(parallel=True, cache=True)
+def _corner_scan(wstart, wseg, seg, cstart, cpair, fill):
+    """Count (fill False: into cstart[i + 1]) or list (fill True) each particle's corners.
+
+    A corner is a pair of i's near segments that share a vertex; listing them once per
+    neighbour-list build spares the kernels a search over all pairs for every neighbour.
+    """
+    for i in prange(wstart.shape[0] - 1):
+        k = 0
+        for w in range(wstart[i], wstart[i + 1]):
+            for w2 in range(w + 1, wstart[i + 1]):
+                if share_vertex(seg, wseg[w], wseg[w2]):
                     if fill:
-                        wseg[wstart[i] + k] = s
+                        cpair[cstart[i] + k, 0] = wseg[w]
+                        cpair[cstart[i] + k, 1] = wseg[w2]
                     k += 1
         if not fill:
-            wstart[i + 1] = k
+            cstart[i + 1] = k
 
 
 @njit(inline="always", cache=True)
@@ -166,6 +239,19 @@ def blocked(xi, yi, xj, yj, wstart, wseg, seg, i):
         if crosses(xi, yi, xj, yj, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]):
             return True
     return False
+
+
+@njit(parallel=True, cache=True)
+def blocked_pairs(x, y, nstart, nbr, wstart, wseg, seg, out):
+    """out[q] = True when a wall near particle i separates it from its neighbour nbr[q].
+
+    Computed once per step (positions fixed) for the density iterations and the forces,
+    which then skip such pairs and their mirror images at the cost of a lookup.
+    """
+    for i in prange(x.shape[0]):
+        near = wstart[i + 1] > wstart[i]
+        for q in range(nstart[i], nstart[i + 1]):
+            out[q] = near and blocked(x[i], y[i], x[nbr[q]], y[nbr[q]], wstart, wseg, seg, i)
 
 
 @njit(inline="always", cache=True)
@@ -197,17 +283,10 @@ def wall_image(xi, yi, px, py, seg, s):
 
 @njit(inline="always", cache=True)
 def corner_image(px, py, seg, s1, s2):
-    """Double mirror image of p about segments s1 then s2 if they share a vertex.
+    """Double mirror image of p about segments s1 then s2, which share a vertex.
 
-    Returns (x'', y'', ok): ok is False unless the segments meet and p's foot lies on both.
+    Returns (x'', y'', ok): ok is False unless p's foot lies on both segments.
     """
-    shared = False
-    for a in range(2):
-        for b in range(2):
-            if seg[s1, 2 * a] == seg[s2, 2 * b] and seg[s1, 2 * a + 1] == seg[s2, 2 * b + 1]:
-                shared = True
-    if not shared:
-        return px, py, False
     x1, y1, on1, _, _ = mirror(px, py, seg[s1, 0], seg[s1, 1], seg[s1, 2], seg[s1, 3])
     _, _, on2, _, _ = mirror(px, py, seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
     x2, y2, _, _, _ = mirror(x1, y1, seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])

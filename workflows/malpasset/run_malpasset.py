@@ -42,14 +42,15 @@ PARTICLE_COUNT_INTERVAL_S = 10.0
 def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_TIME_S,
                 spacing: float = 20.0, gauge_interval: float = 5.0, overwrite: bool = False,
                 max_steps: int | None = None, progress: bool = True,
-                threads: int | None = None) -> dict:
+                threads: int | None = None, refinement: str | None = None) -> dict:
     """Write, run and report one sea mode in ``out/<sea>/``; returns its cost row."""
     from floodsph.run import run_scenario
     from floodsph.scenario import load_scenario
     from floodsph.schedules import TimeInterval
 
     where = out / sea
-    path = setup.write_scenario(folder, where, sea, end_time, spacing, gauge_interval)
+    path = setup.write_scenario(folder, where, sea, end_time, spacing, gauge_interval,
+                                refinement)
     counter = results.ParticleCounter()
     run_dir = where / "run"
     run_scenario(load_scenario(path), out_dir=run_dir, overwrite=overwrite, progress=progress,
@@ -117,6 +118,7 @@ def _child(args, sea: str) -> int:
     cmd += ["--overwrite"] if args.overwrite else []
     cmd += ["--max-steps", str(args.max_steps)] if args.max_steps else []
     cmd += ["--threads", str(args.threads)] if args.threads is not None else []
+    cmd += ["--refinement", args.refinement] if args.refinement else []
     return subprocess.run(cmd, check=False).returncode
 
 
@@ -135,6 +137,8 @@ def main(argv=None) -> int:
     parser.add_argument("--max-steps", type=int, default=None, help="stop after N steps")
     parser.add_argument("--threads", type=int, default=None,
                         help="numba threads (default: all cores)")
+    parser.add_argument("--refinement", choices=("split+coalesce", "split", "none"),
+                        default=None, help="numerics.refinement (default: floodsph's)")
     parser.add_argument("--no-summary", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--write-static", action="store_true",
                         help="(re)write workflows/malpasset/scenario.toml and exit")
@@ -162,7 +166,7 @@ def main(argv=None) -> int:
         try:
             run_variant(folder, args.out, args.sea, args.end_time, args.spacing,
                         args.gauge_interval, args.overwrite, args.max_steps,
-                        threads=args.threads)
+                        threads=args.threads, refinement=args.refinement)
         except InputError as exc:
             print(f"Error: {exc}", file=sys.stderr)
             return 2
