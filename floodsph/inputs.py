@@ -183,7 +183,9 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"Domain:          {t.width / 1000:.3f} km x {t.height / 1000:.3f} km, "
         f"{nx} x {ny} cells of {t.dx:g} m x {t.dy:g} m ({valid} with data)",
         f"CRS:             {crs_label(t.crs_wkt)}",
-        f"Edges:           {scenario.terrain.edges.value}",
+        f"Edges:           {scenario.terrain.edges.value}"
+        + (f" (closed: {', '.join(scenario.terrain.closed_sides)})"
+           if scenario.terrain.closed_sides else ""),
         f"Initial water:   {inputs.volume_initial_m3:.6g} m3 "
         f"({len(scenario.initial_water)} bodies)",
         f"Inflow volume:   {inputs.volume_inflow_m3:.6g} m3 up to the end time "

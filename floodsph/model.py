@@ -124,6 +124,7 @@ class FloodModel:
                          "wall_reflections": 0, "density_unconverged": 0}
         self.bed = np.empty((0, 7))
         self.blocked = np.empty(0, dtype=np.bool_)
+        self._blocked_nl = None
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
         self._remove_outside()
@@ -248,6 +249,7 @@ class FloodModel:
     def _blocked_pairs(self) -> None:
         """Flag the listed pairs that a wall separates, at the current positions."""
         p = self.particles
+        self._blocked_nl = self.nl
         if self.blocked.shape[0] != self.nl.nbr.shape[0]:
             self.blocked = np.empty(self.nl.nbr.shape[0], dtype=np.bool_)
         wallmod.blocked_pairs(p.x, p.y, self.nl.start, self.nl.nbr, self.wstart, self.wseg,
@@ -272,6 +274,8 @@ class FloodModel:
         if self.bed.shape[0] != p.n:
             self.bed = np.empty((p.n, 7))
         bedmod.sample_bed(p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
+        if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
+            self._blocked_pairs()
         forces.internal_acceleration(p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, self.nl.start,
                                      self.nl.nbr, self.blocked, *self.walls_near, self.seg,
                                      self.scheme, p.ax, p.ay, p.divv)

@@ -136,7 +136,8 @@ class Refiner:
         """Split and coalesce the particles of ``model`` in place; return (splits, merges).
 
         Called by ``FloodModel.step`` after the drift and the density prediction; the step
-        then rebuilds the neighbour lists and solves density and h for all particles.
+        then rebuilds the neighbour lists and solves density and h for all particles. Every
+        call first relaxes over-smoothed particles (:func:`relax_smoothing`).
         """
         s = self.settings
         if not s.splits or model.particles.n == 0:

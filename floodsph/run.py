@@ -198,7 +198,7 @@ def build_model(scenario: Scenario, inputs):
         inputs.particles,
         numerics,
         walls=inputs.walls,
-        closed_edges=scenario.terrain.edges is Edges.CLOSED,
+        closed_edges=_closed_edges(scenario.terrain),
         boundaries=open_boundaries(scenario, inputs, numerics),
         refiner=Refiner.from_settings(num.refinement.value, inputs.spacing_m,
                                       area_max=num.refine_area_max,
@@ -206,6 +206,13 @@ def build_model(scenario: Scenario, inputs):
                                       d_min=num.refine_d_min_m,
                                       max_level=num.refine_max_level),
     )
+
+
+def _closed_edges(terrain) -> bool | tuple[str, ...]:
+    """``FloodModel(closed_edges=...)``: True, False, or the sides kept closed."""
+    if terrain.edges is Edges.CLOSED:
+        return True
+    return terrain.closed_sides or False
 
 
 def open_boundaries(scenario: Scenario, inputs, numerics) -> list:

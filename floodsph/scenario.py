@@ -18,9 +18,11 @@ from enum import Enum
 from pathlib import Path
 
 from floodsph.errors import InputError
-from floodsph.scenario_schema import Reader, join
+from floodsph.refinement import Refinement as RefinementSettings
+from floodsph.scenario_schema import Reader, describe, join
 
 Point = tuple[float, float]
+REFINE_DEFAULTS = RefinementSettings()
 
 
 class Edges(Enum):
@@ -76,6 +78,7 @@ class TerrainConfig:
     manning_table: Path | None = None
     extent: tuple[float, float, float, float] | None = None
     edges: Edges = Edges.OPEN
+    closed_sides: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -158,10 +161,10 @@ class NumericsConfig:
     density_tol: float = 1e-3
     friction_depth_floor_m: float = 0.01
     max_slope: float = 1.0
-    refine_area_max: float = 2.0
-    refine_area_min: float = 0.2
-    refine_d_min_m: float = 0.01
-    refine_max_level: int = 3
+    refine_area_max: float = REFINE_DEFAULTS.area_max
+    refine_area_min: float = REFINE_DEFAULTS.area_min
+    refine_d_min_m: float = REFINE_DEFAULTS.d_min
+    refine_max_level: int = REFINE_DEFAULTS.max_level
 
 
 @dataclass(frozen=True)
@@ -334,7 +337,7 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         raise r.fail("terrain", "required table [terrain] is missing")
     p = "terrain"
     allowed = ("dem", "crs", "dem_variable", "manning", "landcover", "manning_table", "extent")
-    t = r.sub_table(data, "", p, allowed + ("edges",))
+    t = r.sub_table(data, "", p, allowed + ("edges", "closed_sides"))
     manning = t.get("manning", TerrainConfig.manning)
     if isinstance(manning, str):
         manning = r.file_value(manning, join(p, "manning"))
@@ -357,6 +360,7 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
             raise r.fail(where, f"expected xmin < xmax and ymin < ymax, got {list(extent)}")
     if landcover is not None:
         manning = None
+    edges = r.choice(t, p, "edges", Edges, TerrainConfig.edges)
     return TerrainConfig(
         dem=r.existing_file(t, p, "dem"),
         crs=r.string(t, p, "crs", None),
@@ -365,8 +369,27 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         landcover=landcover,
         manning_table=manning_table,
         extent=extent,
-        edges=r.choice(t, p, "edges", Edges, TerrainConfig.edges),
+        edges=edges,
+        closed_sides=_closed_sides(r, t, p, edges),
     )
+
+
+SIDES = ("west", "east", "south", "north")
+
+
+def _closed_sides(r: Reader, t: dict, p: str, edges: Edges) -> tuple[str, ...]:
+    """``terrain.closed_sides``: sides of the DEM rectangle that stay walls when edges are open
+    (e.g. the closed west edge of the EA floodplain tests); nodata borders are then walls too."""
+    if t.get("closed_sides", []) == []:
+        return ()
+    where = join(p, "closed_sides")
+    value = t["closed_sides"]
+    if edges is not Edges.OPEN:
+        raise r.fail(where, 'only applies with edges = "open" (closed edges close every side)')
+    if not isinstance(value, list) or not all(side in SIDES for side in value):
+        raise r.fail(where, f"expected a list of sides from {list(SIDES)}, got "
+                            f"{describe(value)}")
+    return tuple(side for side in SIDES if side in value)
 
 
 def _initial_water(r: Reader, t: dict, p: str) -> InitialWater:

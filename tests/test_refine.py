@@ -303,3 +303,39 @@ def test_refined_dam_break_matches_the_fine_uniform_run_at_a_third_of_the_cost()
     assert counters["splits"] > 0 and mass_err < 1e-12
     assert l1 <= 1.2 * l1_fine
     assert steps <= steps_fine / 3
+
+
+def test_split_daughters_relax_to_sqrt3_lattice_smoothing_and_lattice_particles_stay():
+    from floodsph.refinement import RELAX_RATE, SMOOTHING_EXCESS, relax_smoothing
+
+    model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
+    p = model.particles
+    h0_lattice = p.h0[0]
+    assert np.all(p.h0 == h0_lattice)
+    kappa = model.numerics.kappa
+    Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0).execute(
+        model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.0), [], [])
+    daughters = p.level > 0
+    c0 = p.h0**2 * p.rho0
+    target = SMOOTHING_EXCESS * kappa**2 * p.m
+    assert np.all(c0[daughters] > 1.5 * target[daughters])  # 0.9 h_p with a seventh of m_p
+    relax_smoothing(p, kappa)
+    c1 = p.h0**2 * p.rho0
+    np.testing.assert_allclose(c1[daughters],
+                               c0[daughters] * (target[daughters] / c0[daughters]) ** RELAX_RATE,
+                               rtol=1e-12)
+    assert np.all(p.h0[~daughters] == h0_lattice)
+    for _ in range(60):
+        relax_smoothing(p, kappa)
+    np.testing.assert_allclose(p.h0**2 * p.rho0 / target, np.where(daughters, 1.0, 1 / 3),
+                               rtol=1e-5)
+
+
+def test_a_small_particle_beside_a_large_one_still_finds_its_merge_partner():
+    x = np.array([0.0, 1.0, 0.3])  # 0's nearest neighbour is 2, a large non-candidate
+    y = np.zeros(3)
+    nstart = np.array([0, 2, 4, 6])
+    nbr = np.array([1, 2, 0, 2, 0, 1])
+    out = np.empty(3, dtype=np.int64)
+    refine.nearest_candidate(x, y, nstart, nbr, np.array([True, True, False]), out)
+    assert out.tolist() == [1, 0, -1]

@@ -92,6 +92,11 @@ POLY = "[[0, 0], [10, 0], [10, 10]]"
          "pair is not split again at once; got 1.5"),
         (('refinement = "none"', "refine_max_level = -1"),
          "numerics.refine_max_level: must be >= 0, got -1"),
+        (('edges = "closed"', 'edges = "closed"\nclosed_sides = ["west"]'),
+         'terrain.closed_sides: only applies with edges = "open"'),
+        (('edges = "closed"', 'edges = "open"\nclosed_sides = ["up"]'),
+         "terrain.closed_sides: expected a list of sides from ['west', 'east', 'south', "
+         "'north'], got array ['up']"),
         (('edges = "closed"', 'edges = "sometimes"'),
          "terrain.edges: expected one of 'open', 'closed', got string 'sometimes'"),
         (("resolution_m = 10.0", "wet_threshold_m = -0.1"),
@@ -201,3 +206,19 @@ def test_refinement_thresholds_reach_the_refiner(write_scenario):
     assert refiner.area_min == pytest.approx(0.5 * spacing**2)
     assert (refiner.settings.d_min, refiner.settings.max_level) == (0.05, 2)
     assert refiner.settings.coalesces
+
+
+def test_closed_sides_are_walls_and_the_other_sides_open(write_scenario):
+    from floodsph.boundaries import OpenEdges
+    from floodsph.inputs import prepare_inputs
+    from floodsph.run import build_model
+
+    text = BASE_SCENARIO.replace('edges = "closed"', 'edges = "open"\nclosed_sides = ["west"]')
+    scenario = load_scenario(write_scenario(text))
+    assert scenario.terrain.closed_sides == ("west",)
+    model = build_model(scenario, prepare_inputs(scenario))
+    (edges,) = [b for b in model.boundaries if isinstance(b, OpenEdges)]
+    assert set(edges.sides) == {"east", "south", "north"}
+    west = model.seg[(model.seg[:, 0] == 0.0) & (model.seg[:, 2] == 0.0)]
+    assert west.shape[0] == 1
+    assert abs(west[0, 3] - west[0, 1]) >= model.terrain.height  # the whole side, and beyond

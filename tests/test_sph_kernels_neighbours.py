@@ -127,3 +127,37 @@ def test_verlet_lists_kept_over_steps_give_the_flow_of_lists_rebuilt_every_step(
     assert kept < steps / 2
     assert states[0][:, 0].max() > 280.0  # the front has passed the building
     np.testing.assert_allclose(states[1], states[0], rtol=1e-8, atol=1e-8)
+
+
+def test_wall_lists_equal_a_brute_force_search():
+    """Segments longer than the buckets, diagonal ones, radii spanning several buckets:
+    every segment within reach is listed once, in index order, with its corners and the
+    pairs it blocks."""
+    from floodsph.sph import walls
+
+    rng = np.random.default_rng(7)
+    start = rng.uniform(0.0, 400.0, (120, 2))
+    seg = np.c_[start, start + rng.normal(0.0, 60.0, (120, 2))]
+    seg[1::2, :2] = seg[:-1:2, 2:]  # every odd segment starts where the one before ends
+    n = 3000
+    x, y = rng.uniform(-30.0, 430.0, n), rng.uniform(-30.0, 430.0, n)
+    h = rng.uniform(2.0, 40.0, n)
+    nl = NeighbourList(x, y, h)
+    index = walls.WallIndex(seg, (0.0, 0.0, 400.0, 400.0), bucket=15.0)
+    wstart, wseg, cstart, cpair = index.near_lists(x, y, h, nl.start, nl.nbr, nl.reach)
+    blocked = np.empty(nl.nbr.size, dtype=np.bool_)
+    walls.blocked_pairs(x, y, nl.start, nl.nbr, wstart, wseg, seg, blocked)
+    assert cpair.shape[0] > 100 and blocked.sum() > 100
+    for i in range(0, n, 7):
+        nbrs = nl.nbr[nl.start[i]:nl.start[i + 1]]
+        radius = nl.reach * max(h[i], h[nbrs].max(initial=0.0))
+        dist = np.array([walls.segment_distance(x[i], y[i], *s) for s in seg])
+        near = np.flatnonzero(dist < radius)
+        np.testing.assert_array_equal(wseg[wstart[i]:wstart[i + 1]], near)
+        corners = [[a, b] for k, a in enumerate(near) for b in near[k + 1:]
+                   if {tuple(seg[a, :2]), tuple(seg[a, 2:])} & {tuple(seg[b, :2]),
+                                                                tuple(seg[b, 2:])}]
+        assert cpair[cstart[i]:cstart[i + 1]].tolist() == corners
+        for q, j in enumerate(nbrs):
+            crossed = any(walls.crosses(x[i], y[i], x[j], y[j], *seg[s]) for s in near)
+            assert blocked[nl.start[i] + q] == crossed

@@ -36,6 +36,7 @@ CASES = {
     "malpasset": (REPO / "workflows" / "malpasset" / "scenario.toml", 1000.0),
 }
 WET_M = 0.1
+REFINE_KEYS = ("refine_area_max", "refine_area_min", "refine_d_min_m", "refine_max_level")
 
 
 class StepCounter:
@@ -157,8 +158,12 @@ def main() -> None:
                     help="[numerics] refinement keys, e.g. refine_area_min=0.5")
     args = ap.parse_args()
     out = args.out.resolve()
-    settings = {k: float(v) if "." in v else int(v)
-                for k, v in (item.split("=", 1) for item in args.set)}
+    settings = {}
+    for item in args.set:
+        key, _, value = item.partition("=")
+        if key not in REFINE_KEYS:
+            ap.error(f"--set {item}: key must be one of {REFINE_KEYS}")
+        settings[key] = int(value) if key == "refine_max_level" else float(value)
     rows, pairs = [], []
     for case in args.cases:
         done = []

@@ -13,8 +13,8 @@ ANUGA set-up, one-to-one with the floodsph inputs (``floodsph.inputs.prepare_inp
   triangles, in the same local frame (origin = lower-left DEM corner);
 * bed, Manning n and initial depth: each triangle takes the value of the DEM cell holding its
   centroid (stage = bed + depth, so a reservoir starts flat at its level);
-* edges ``"open"``: ``Transmissive_boundary`` (free outflow); ``"closed"``: walls
-  (``Reflective_boundary``);
+* edges ``"open"``: ``Transmissive_boundary`` (free outflow), except ``closed_sides`` and
+  sides walled along their length; ``"closed"``: walls (``Reflective_boundary``);
 * ``[[inflows]]``: ``anuga.Inlet_operator`` along the inflow line (moved a quarter cell inside
   the domain when it lies on the border) with Q(t) from the same hydrograph;
 * maximum depth: ``Collect_max_quantities_operator`` (every step) together with the initial
@@ -190,10 +190,12 @@ def translate_walls(scenario, terrain) -> set[str]:
     def local(points):
         return np.column_stack(terrain.to_local(*np.asarray(points, dtype=np.float64).T))
 
+    anuga_side = {"west": "left", "east": "right", "south": "bottom", "north": "top"}
+    closed = {anuga_side[side] for side in scenario.terrain.closed_sides}
     try:
-        return walled_sides([local(w.polyline) for w in scenario.walls],
-                            [local(f.line) for f in scenario.inflows], terrain.width,
-                            terrain.height, 1e-6 * max(terrain.width, terrain.height))
+        return closed | walled_sides([local(w.polyline) for w in scenario.walls],
+                                     [local(f.line) for f in scenario.inflows], terrain.width,
+                                     terrain.height, 1e-6 * max(terrain.width, terrain.height))
     except ValueError as err:
         raise SystemExit(f"{scenario.path}: [[walls]]: {err}; only walls along the DEM border "
                          "have an ANUGA translation in this workflow") from None

@@ -9,7 +9,7 @@ mass per split). Smoothing length h_k = a h_p with a = 0.9; velocity v_k = v_p, 
 sum_k m_k v_k = m_p v_p exactly.
 
 Coalescing (Vacondio, Rogers, Stansby & Mignosa, Adv. Water Resour. 58 (2013) 10-23; notes
-section 5). Two particles a, b that are each other's nearest neighbour merge into M with
+section 5). Two merge candidates a, b that are each other's nearest candidate merge into M with
 
     m_M = m_a + m_b,   x_M = (m_a x_a + m_b x_b) / m_M,   v_M = (m_a v_a + m_b v_b) / m_M,
 

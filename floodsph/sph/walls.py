@@ -22,7 +22,10 @@ the edges are closed. Three mechanisms keep water on its side:
 Near-wall lists are CSR arrays ``(wstart, wseg)`` built with the neighbour lists, with the
 same skin, for the particles within the interaction radius of a segment (and kept as long as
 the neighbour lists are: a wall within the support now was within the skinned radius at the
-build); most particles have none and pay nothing.
+build), together with each particle's corners ``(cstart, cpair)``: the pairs of its near
+segments that share a vertex, listed in ``wseg`` order. Most particles have none and pay
+nothing. Which listed pairs a wall separates is found once per step (:func:`blocked_pairs`)
+for the density iterations and the forces.
 """
 
 from __future__ import annotations

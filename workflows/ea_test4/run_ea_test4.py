@@ -49,9 +49,10 @@ END_TIME_S = 18000.0
 #: The inflow opening on the west edge x = 0 (ea4_boundaries.csv), water entering eastwards.
 INLET = ((0.0, 990.0), (0.0, 1010.0))
 INLET_DIRECTION = (1.0, 0.0)
-#: The rest of the west edge is a wall (LISFLOOD-FP's default closed boundary); the other
-#: edges are free (transmissive): ``edges = "open"`` removes water that reaches them.
-WEST_WALLS = (((0.0, 0.0), (0.0, 990.0)), ((0.0, 1010.0), (0.0, 2000.0)))
+#: The rest of the west edge is a wall (LISFLOOD-FP's default closed boundary; the inflow
+#: cuts its opening out of it); the other edges are free (transmissive): ``edges = "open"``
+#: with ``closed_sides = ["west"]``.
+CLOSED_SIDES = ("west",)
 WET_THRESHOLD_M = 0.01
 GAUGE_INTERVAL_S = 10.0
 
@@ -92,8 +93,8 @@ def write_inputs(folder: Path, out: Path, end_time: float, dem_cell: int,
                            "trapezoidal inflow through a 20 m opening in the west edge",
         },
         "terrain": {"dem": str(folder / DEM_NAMES[dem_cell]), "crs": CRS,
-                    "manning": MANNING_N, "edges": "open"},
-        "walls": [{"polyline": [list(p) for p in wall]} for wall in WEST_WALLS],
+                    "manning": MANNING_N, "edges": "open",
+                    "closed_sides": list(CLOSED_SIDES)},
         "inflows": [{"line": [list(p) for p in INLET], "hydrograph": "ea4_hydrograph.csv",
                      "direction": list(INLET_DIRECTION)}],
         "gauges": {"file": "ea4_gauges.csv", "interval_s": GAUGE_INTERVAL_S},
