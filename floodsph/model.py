@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from floodsph.boundaries.nodata_walls import nodata_polylines, settle_seeds
 from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
 from floodsph.boundaries.open_edges import OpenEdges
 from floodsph.boundaries.openings import cut_openings
@@ -111,7 +112,8 @@ class FloodModel:
         segs = [wallmod.segments_from_polylines(walls),
                 _side_segments(terrain, closed, extension=6.0 * h0)]
         if closed_edges is not False:
-            segs.append(wallmod.mask_boundary_segments(terrain.valid, terrain.dx, terrain.dy))
+            segs.append(wallmod.segments_from_polylines(
+                nodata_polylines(terrain.valid, terrain.dx, terrain.dy)))
         openings = [b.opening for b in self.boundaries if hasattr(b, "opening")]
         self.seg = cut_openings(np.concatenate(segs), openings, 1e-6 * numerics.spacing)
         self.wall_index = wallmod.WallIndex(
@@ -127,7 +129,11 @@ class FloodModel:
         self._blocked_nl = None
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
-        self._remove_outside()
+        n = particles.n
+        particles.x[:n], particles.y[:n] = settle_seeds(
+            particles.x[:n], particles.y[:n], terrain.valid, terrain.dx, terrain.dy,
+            numerics.spacing)
+        self._remove_outside(nodata=True)
         self._interactions()
         self.dt = self.stable_dt()
 
@@ -166,7 +172,7 @@ class FloodModel:
             p.x, p.y, p.u, p.v, dt, self.wstart, self.wseg, self.seg))
         for boundary in self.boundaries:
             boundary.apply(self, dt)
-        self._remove_outside()
+        self._remove_outside(nodata=self.closed_edges is False)
         density.predict(p.rho, p.h, p.divv, dt)
         if self.refiner is not None:
             splits, merges = self.refiner.apply(self)
@@ -215,15 +221,18 @@ class FloodModel:
         self._forces()
         p.truncate(water)
 
-    def _remove_outside(self) -> None:
-        """Remove (and count as outflow) particles off the grid or in nodata cells."""
+    def _remove_outside(self, nodata: bool) -> None:
+        """Remove (and count as outflow) particles off the grid, and in nodata cells if
+        ``nodata``: always at construction, and in a step when nodata is not walled off (the
+        walled nodata border runs through nodata cells, whose slivers are then wet area)."""
         p = self.particles
         t = self.terrain
         ny, nx = t.shape
         col = np.floor(p.x / t.dx).astype(np.int64)
         row = np.floor(p.y / t.dy).astype(np.int64)
         inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
-        inside[inside] = t.valid[row[inside], col[inside]]
+        if nodata:
+            inside[inside] = t.valid[row[inside], col[inside]]
         if not inside.all():
             self.volume_out += float(p.m[~inside].sum() / RHO_WATER)
             p.keep(inside)

@@ -131,14 +131,16 @@ def test_verlet_lists_kept_over_steps_give_the_flow_of_lists_rebuilt_every_step(
 
 def test_wall_lists_equal_a_brute_force_search():
     """Segments longer than the buckets, diagonal ones, radii spanning several buckets:
-    every segment within reach is listed once, in index order, with its corners and the
-    pairs it blocks."""
+    every segment within reach is listed once, in index order, with its right-angled corners
+    and the pairs it blocks."""
     from floodsph.sph import walls
 
     rng = np.random.default_rng(7)
     start = rng.uniform(0.0, 400.0, (120, 2))
     seg = np.c_[start, start + rng.normal(0.0, 60.0, (120, 2))]
     seg[1::2, :2] = seg[:-1:2, 2:]  # every odd segment starts where the one before ends
+    turn = seg[0:-1:4, 2:] - seg[0:-1:4, :2]  # and every other one of them turns 90 degrees
+    seg[1::4, 2:] = seg[1::4, :2] + 0.7 * np.c_[-turn[:, 1], turn[:, 0]]
     n = 3000
     x, y = rng.uniform(-30.0, 430.0, n), rng.uniform(-30.0, 430.0, n)
     h = rng.uniform(2.0, 40.0, n)
@@ -147,7 +149,7 @@ def test_wall_lists_equal_a_brute_force_search():
     wstart, wseg, cstart, cpair = index.near_lists(x, y, h, nl.start, nl.nbr, nl.reach)
     blocked = np.empty(nl.nbr.size, dtype=np.bool_)
     walls.blocked_pairs(x, y, nl.start, nl.nbr, wstart, wseg, seg, blocked)
-    assert cpair.shape[0] > 100 and blocked.sum() > 100
+    assert cpair.shape[0] > 50 and blocked.sum() > 100
     for i in range(0, n, 7):
         nbrs = nl.nbr[nl.start[i]:nl.start[i + 1]]
         radius = nl.reach * max(h[i], h[nbrs].max(initial=0.0))
@@ -156,7 +158,10 @@ def test_wall_lists_equal_a_brute_force_search():
         np.testing.assert_array_equal(wseg[wstart[i]:wstart[i + 1]], near)
         corners = [[a, b] for k, a in enumerate(near) for b in near[k + 1:]
                    if {tuple(seg[a, :2]), tuple(seg[a, 2:])} & {tuple(seg[b, :2]),
-                                                                tuple(seg[b, 2:])}]
+                                                                tuple(seg[b, 2:])}
+                   and abs(np.dot(seg[a, 2:] - seg[a, :2], seg[b, 2:] - seg[b, :2]))
+                   < 1e-6 * np.hypot(*(seg[a, 2:] - seg[a, :2])) * np.hypot(*(seg[b, 2:]
+                                                                              - seg[b, :2]))]
         assert cpair[cstart[i]:cstart[i + 1]].tolist() == corners
         for q, j in enumerate(nbrs):
             crossed = any(walls.crosses(x[i], y[i], x[j], y[j], *seg[s]) for s in near)

@@ -34,6 +34,7 @@ import math
 
 import numpy as np
 from numba import njit, prange
+from scipy import ndimage
 
 from floodsph.constants import RHO_WATER
 from floodsph.sph.kernels import w_cubic
@@ -102,9 +103,27 @@ def kernel_sums(px, py, x, y, u, v, m, rho, h) -> np.ndarray:
         gx, gy, gh = x[group], y[group], h[group]
         bounds = (gx.min(), gy.min(), gx.max(), gy.max())
         grid = CellGrid(gx, gy, 2.0 * float(gh.max()), bounds)
-        accumulate_sums(px, py, gx, gy, gh, vol[group], d[group], u[group], v[group],
-                        *grid.arrays(), sums)
+        k = np.flatnonzero(_reached(px, py, grid))
+        part = np.zeros((k.size, 4), dtype=np.float64)
+        accumulate_sums(px[k], py[k], gx, gy, gh, vol[group], d[group], u[group], v[group],
+                        *grid.arrays(), part)
+        sums[k] += part
     return sums
+
+
+def _reached(px, py, grid: CellGrid) -> np.ndarray:
+    """True for the points with a particle in the 3 x 3 cells around them: the only points
+    :func:`accumulate_sums` can add to (a map grid is mostly dry, so the rest are skipped)."""
+    cell_start, _, xmin, ymin, cell, ncx, ncy = grid.arrays()
+    filled = np.zeros((ncy + 2, ncx + 2), dtype=bool)
+    filled[1:-1, 1:-1] = (np.diff(cell_start) > 0).reshape(ncy, ncx)
+    near = ndimage.binary_dilation(filled, structure=np.ones((3, 3), dtype=bool))
+    cx = np.floor((px - xmin) / cell) + 1.0
+    cy = np.floor((py - ymin) / cell) + 1.0
+    inside = (cx >= 0) & (cx <= ncx + 1) & (cy >= 0) & (cy <= ncy + 1)
+    out = np.zeros(px.shape, dtype=bool)
+    out[inside] = near[cy[inside].astype(np.int64), cx[inside].astype(np.int64)]
+    return out
 
 
 def interpolate(px, py, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT):

@@ -12,9 +12,9 @@ the edges are closed. Three mechanisms keep water on its side:
    boundary particles of Vacondio, Rogers & Stansby, IJNMF 69 (2012) 226-253 approximate).
    An image counts only if the line from i to it passes through the segment that made it,
    so that behind a convex corner (a building's) each point is imaged once, not by both faces.
-   In a corner where two near segments meet, j's foot on both gives a third image, the
-   reflection of j's first image about the second wall (the point reflection through a
-   right-angled corner), which completes the kernel there too.
+   In a right-angled corner where two near segments meet, j's foot on both gives a third
+   image, the reflection of j's first image about the second wall (the point reflection
+   through the corner), which completes the kernel there too.
 2. **Pair blocking.** Particles on opposite sides of a wall do not interact.
 3. **Crossing guard.** A drift step that would cross a wall is reflected about it (position and
    normal velocity), so no particle ever crosses, whatever the time step (:func:`drift`).
@@ -23,7 +23,7 @@ Near-wall lists are CSR arrays ``(wstart, wseg)`` built with the neighbour lists
 same skin, for the particles within the interaction radius of a segment (and kept as long as
 the neighbour lists are: a wall within the support now was within the skinned radius at the
 build), together with each particle's corners ``(cstart, cpair)``: the pairs of its near
-segments that share a vertex, listed in ``wseg`` order. Most particles have none and pay
+segments that meet at a right angle, listed in ``wseg`` order. Most particles have none and pay
 nothing. Which listed pairs a wall separates is found once per step (:func:`blocked_pairs`)
 for the density iterations and the forces.
 """
@@ -90,8 +90,8 @@ class WallIndex:
         """CSR lists of the segments within each particle's reach, and of its wall corners.
 
         Returns (wstart, wseg, cstart, cpair): particle i's near segments are
-        ``wseg[wstart[i]:wstart[i + 1]]``, and the pairs of them that share a vertex (the
-        corners that make double images) are the rows ``cpair[cstart[i]:cstart[i + 1]]``.
+        ``wseg[wstart[i]:wstart[i + 1]]``, and the pairs of them that meet at a right
+        angle (the corners that make double images) are the rows ``cpair[cstart[i]:cstart[i + 1]]``.
         The radius of particle i is reach * max(h_i, max_j h_j) over its neighbours j, so a
         wall between i and any neighbour is always in i's list (pair blocking is symmetric).
         """
@@ -188,6 +188,20 @@ def _sort_run(a, lo, hi):
 
 
 @njit(inline="always", cache=True)
+def right_corner(seg, s1, s2):
+    """True if segments s1 and s2 share an end point and meet at a right angle
+    (|cos| < 1e-6), the corners whose double mirror image completes the kernel."""
+    e1x = seg[s1, 2] - seg[s1, 0]
+    e1y = seg[s1, 3] - seg[s1, 1]
+    e2x = seg[s2, 2] - seg[s2, 0]
+    e2y = seg[s2, 3] - seg[s2, 1]
+    dot = e1x * e2x + e1y * e2y
+    if dot * dot > 1e-12 * (e1x * e1x + e1y * e1y) * (e2x * e2x + e2y * e2y):
+        return False
+    return share_vertex(seg, s1, s2)
+
+
+@njit(inline="always", cache=True)
 def share_vertex(seg, s1, s2):
     """True if segments s1 and s2 have an end point in common (exactly)."""
     for a in range(2):
@@ -201,14 +215,17 @@ def share_vertex(seg, s1, s2):
 def _corner_scan(wstart, wseg, seg, cstart, cpair, fill):
     """Count (fill False: into cstart[i + 1]) or list (fill True) each particle's corners.
 
-    A corner is a pair of i's near segments that share a vertex; listing them once per
-    neighbour-list build spares the kernels a search over all pairs for every neighbour.
+    A corner is a pair of i's near segments that meet at a right angle
+    (:func:`right_corner`); listing them once per neighbour-list build spares the kernels a
+    search over all pairs for every neighbour. At other angles the double image of a point
+    (a rotation by twice the angle between the walls) can fall in the water, so those corners
+    get the single images only.
     """
     for i in prange(wstart.shape[0] - 1):
         k = 0
         for w in range(wstart[i], wstart[i + 1]):
             for w2 in range(w + 1, wstart[i + 1]):
-                if share_vertex(seg, wseg[w], wseg[w2]):
+                if right_corner(seg, wseg[w], wseg[w2]):
                     if fill:
                         cpair[cstart[i] + k, 0] = wseg[w]
                         cpair[cstart[i] + k, 1] = wseg[w2]
@@ -335,33 +352,3 @@ def drift(x, y, u, v, dt, wstart, wseg, seg):
             v[i] = 0.0
         total += hits
     return total
-
-
-def mask_boundary_segments(valid: np.ndarray, dx: float, dy: float) -> np.ndarray:
-    """Wall segments along the cell edges between valid and invalid (nodata) cells.
-
-    Collinear unit edges are merged into runs, so a straight nodata border is one segment.
-    The grid border itself is not included (see :func:`box_polyline`). Row 0 is south.
-    """
-    ok = np.asarray(valid, dtype=bool)
-    ny, nx = ok.shape
-    segs = []
-    # vertical edges between columns j-1 and j (x = j dx), for j = 1..nx-1
-    diff_v = ok[:, 1:] != ok[:, :-1]
-    for j in range(nx - 1):
-        segs.extend((
-            ((j + 1) * dx, a * dy, (j + 1) * dx, b * dy) for a, b in _runs(diff_v[:, j])
-        ))
-    diff_h = ok[1:, :] != ok[:-1, :]
-    for i in range(ny - 1):
-        segs.extend((
-            (a * dx, (i + 1) * dy, b * dx, (i + 1) * dy) for a, b in _runs(diff_h[i, :])
-        ))
-    return np.asarray(segs, dtype=np.float64).reshape(-1, 4)
-
-
-def _runs(flags: np.ndarray):
-    """(start, end) index pairs of the runs of True in a 1-D boolean array."""
-    padded = np.concatenate(([False], flags, [False]))
-    edges = np.flatnonzero(padded[1:] != padded[:-1])
-    return zip(edges[0::2], edges[1::2], strict=True)

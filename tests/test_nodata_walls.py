@@ -1,0 +1,158 @@
+"""The nodata border as simplified walls: tracing, outward simplification, seeds, still water."""
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from floodsph.boundaries import nodata_walls as nw
+from floodsph.constants import RHO_WATER
+from floodsph.initial import seed_particles
+from floodsph.model import FloodModel, Numerics
+from floodsph.terrain import Terrain
+
+
+def blob(n=60, seed=3):
+    """A valid region with a ragged border: a disc, a bay and a few nodata specks."""
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[0:n, 0:n] + 0.5
+    r = np.hypot(xx - n / 2, yy - n / 2)
+    ok = r < 0.4 * n + rng.uniform(-1.0, 1.0, (n, n))
+    ok[n // 2 - 3:n // 2 + 3, :n // 4] = False
+    return ok
+
+
+def unit_edges(ok):
+    """Set of directed unit edges with the valid cell on the left, the grid border excluded."""
+    edges = set()
+    ny, nx = ok.shape
+    for i in range(ny):
+        for j in range(nx - 1):
+            if ok[i, j] != ok[i, j + 1]:
+                a, b = (j + 1, i), (j + 1, i + 1)
+                edges.add((a, b) if ok[i, j] else (b, a))
+    for i in range(ny - 1):
+        for j in range(nx):
+            if ok[i, j] != ok[i + 1, j]:
+                a, b = (j, i + 1), (j + 1, i + 1)
+                edges.add((a, b) if ok[i + 1, j] else (b, a))
+    return edges
+
+
+def test_trace_covers_every_border_edge_once_with_valid_on_the_left():
+    ok = blob()
+    traced = []
+    for chain in nw.trace(ok):
+        for a, b in zip(chain[:-1], chain[1:], strict=True):
+            step = np.sign(b - a)
+            for k in range(int(np.abs(b - a).sum())):
+                p = a + k * step
+                traced.append((tuple(p.tolist()), tuple((p + step).tolist())))
+    assert len(traced) == len(set(traced))
+    assert set(traced) == unit_edges(ok)
+
+
+@pytest.mark.parametrize("tolerance", [0.5, 1.0, 2.0])
+def test_simplified_walls_keep_every_valid_cell_inside(tolerance):
+    """Every skipped vertex lies on the chord's valid side within the tolerance, and only
+    nodata lies on a chord's right (no valid cell is cut or walled off)."""
+    ok = blob()
+    chains = nw.trace(ok)
+    simple = [nw.simplify_outward(c, ok, tolerance) for c in chains]
+    for chain, line in zip(chains, simple, strict=True):
+        np.testing.assert_array_equal(line[[0, -1]], chain[[0, -1]])
+        pts = chain.astype(float)
+        at = [0]
+        for v in line[1:]:  # the chain may pass a saddle vertex twice: search onwards
+            at.append(at[-1] + 1 + int(np.flatnonzero((pts[at[-1] + 1:] == v).all(axis=1))[0]))
+        for a, b in zip(at[:-1], at[1:], strict=True):
+            e = pts[b] - pts[a]
+            rel = pts[a + 1:b] - pts[a]
+            side = (e[0] * rel[:, 1] - e[1] * rel[:, 0]) / np.hypot(*e)
+            assert np.all(side >= -1e-9) and np.all(side <= tolerance + 1e-9)
+            t = np.linspace(0.0, 1.0, 401)[1:-1, None]
+            xy = pts[a] + t * e
+            # the chord may run along a valid cell's edge (its right side is nodata there),
+            # never through a valid cell's interior
+            q = np.floor(xy + np.array([e[1], -e[0]]) / np.hypot(*e) * 1e-7).astype(int)
+            assert not ok[q[:, 1], q[:, 0]].any()
+
+
+def test_a_digitised_disc_needs_few_chords():
+    """A disc of radius 24 cells: 116 staircase segments become 32 chords of about 4.7 cells
+    (chord 2 sqrt(2 R tol) = 13.9 cells at most for tol = 1 cell; the digitisation's
+    irregular steps cut some short)."""
+    yy, xx = np.mgrid[0:60, 0:60] + 0.5
+    ok = np.hypot(xx - 30.0, yy - 30.0) < 24.0
+    (chain,) = nw.trace(ok)
+    assert len(chain) - 1 == 116
+    assert len(nw.simplify_outward(chain, ok, 1.0)) - 1 <= 40
+
+
+def test_settle_seeds_moves_seeds_off_nodata_and_off_wall_lines():
+    ok = np.ones((10, 10), dtype=bool)
+    ok[:, 6:] = False
+    x = np.array([6.2, 3.0, 2.5, 9.9])  # nodata (moves), shore corner (nudged), inland, far
+    y = np.array([4.5, 4.0, 2.5, 5.5])
+    sx, sy = nw.settle_seeds(x, y, ok, 1.0, 1.0, reach=1.0)
+    assert (sx[0], sy[0]) == (5.5, 4.5)  # centre of the nearest valid cell
+    assert (sx[1], sy[1]) == (3.0, 4.0)  # not next to nodata: untouched
+    assert (sx[2], sy[2]) == (2.5, 2.5)
+    assert (sx[3], sy[3]) == (9.9, 5.5)  # nearest valid centre is 4.4 cells away: stays
+    sx, sy = nw.settle_seeds(np.array([5.0, 6.0]), np.array([3.0, 2.5]), ok, 1.0, 1.0, 1.0)
+    # on the shore cells' corner and on the nodata border: moved into the valid cell
+    np.testing.assert_allclose(sx, [5.05, 5.5])
+    np.testing.assert_allclose(sy, [3.05, 2.5])
+
+
+def oblique_basin(cell=5.0, n=80, angle=30.0):
+    """A flat basin whose nodata border is a staircase at ``angle`` degrees on both sides."""
+    yy, xx = (np.mgrid[0:n, 0:n] + 0.5) * cell
+    c = 0.5 * n * cell
+    t = np.radians(angle)
+    across = -(xx - c) * np.sin(t) + (yy - c) * np.cos(t)
+    along = (xx - c) * np.cos(t) + (yy - c) * np.sin(t)
+    valid = (np.abs(across) < 0.3 * n * cell) & (np.abs(along) < 0.42 * n * cell)
+    return Terrain(np.zeros((n, n)), cell, cell, manning=0.0, valid=valid)
+
+
+def lake_model():
+    """Still water 2 m deep (spacing 5 m) in :func:`oblique_basin`, and its volume."""
+    terrain = oblique_basin()
+    p = seed_particles(terrain, np.where(terrain.valid, 2.0, 0.0), 5.0, 1.3)
+    volume = float(np.sum(p.m[:p.n]) / RHO_WATER)
+    return terrain, FloodModel(terrain, p, Numerics(spacing=5.0), closed_edges=True), volume
+
+
+def test_oblique_nodata_walls_hold_the_water():
+    """A lake in a basin bounded by 30-degree staircases of nodata, simplified to a few
+    chords: nothing is lost at construction, mass is exact, and after 40 s of the sloshing
+    the seeding gap at the walls starts, no particle has left the walls' inside (a valid
+    cell, or a nodata cell next to one)."""
+    terrain, model, volume = lake_model()
+    stair = sum(len(c) - 1 for c in nw.trace(terrain.valid))
+    assert model.seg.shape[0] - 4 < 0.35 * stair  # the 4 closed grid sides included
+    assert model.volume_out == 0.0 and model.particles.n == 3222
+    assert abs(model.volume() - volume) < 1e-9 * volume
+    while model.t < 40.0:
+        model.step()
+    q = model.particles
+    assert q.n == 3222 and model.volume_out == 0.0
+    assert abs(model.volume() - volume) < 1e-9 * volume
+    col = np.floor(q.x[:q.n] / terrain.dx).astype(int)
+    row = np.floor(q.y[:q.n] / terrain.dy).astype(int)
+    near_valid = ndimage.binary_dilation(terrain.valid, structure=np.ones((3, 3), bool))
+    assert near_valid[row, col].all()
+
+
+@pytest.mark.xfail(strict=True, reason="issue 2: along oblique walls still water does not stay "
+                   "still (chords through the staircase's outer corners leave a seeding gap of "
+                   "up to 0.7 cells; corners between chords get no double image); measured "
+                   "p95 0.45 m/s, max 1.9 m/s over 100 s (the unsimplified staircase: p95 0.9, "
+                   "max 131 m/s)")
+def test_lake_at_rest_between_oblique_nodata_walls():
+    """The method's lake-at-rest target along walls: max speed below 1 cm/s."""
+    _, model, _ = lake_model()
+    while model.t < 20.0:
+        model.step()
+    q = model.particles
+    assert np.hypot(q.u[:q.n], q.v[:q.n]).max() < 0.01
