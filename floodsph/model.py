@@ -169,7 +169,7 @@ class FloodModel:
         p.u[:] += half * p.ax
         p.v[:] += half * p.ay
         self.counters["wall_reflections"] += int(wallmod.drift(
-            p.x, p.y, p.u, p.v, dt, self.wstart, self.wseg, self.seg))
+            p.x, p.y, p.u, p.v, dt, *self.walls_near[:2], self.seg))
         for boundary in self.boundaries:
             boundary.apply(self, dt)
         self._remove_outside(nodata=self.closed_edges is False)
@@ -193,7 +193,7 @@ class FloodModel:
 
     def near_wall(self) -> np.ndarray:
         """True for particles with a wall segment within their kernel reach (needs ``nl``)."""
-        return np.diff(self.wstart) > 0
+        return np.diff(self.walls_near[0]) > 0
 
     def protected(self) -> np.ndarray:
         """True for particles near a wall or in an open boundary's zone (no merging there)."""
@@ -253,7 +253,6 @@ class FloodModel:
         self.nl = NeighbourList(p.x, p.y, p.h, skin=self.numerics.neighbour_skin)
         self.walls_near = self.wall_index.near_lists(p.x, p.y, p.h, self.nl.start, self.nl.nbr,
                                                      self.nl.reach)
-        self.wstart, self.wseg = self.walls_near[:2]
 
     def _blocked_pairs(self) -> None:
         """Flag the listed pairs that a wall separates, at the current positions."""
@@ -261,7 +260,7 @@ class FloodModel:
         self._blocked_nl = self.nl
         if self.blocked.shape[0] != self.nl.nbr.shape[0]:
             self.blocked = np.empty(self.nl.nbr.shape[0], dtype=np.bool_)
-        wallmod.blocked_pairs(p.x, p.y, self.nl.start, self.nl.nbr, self.wstart, self.wseg,
+        wallmod.blocked_pairs(p.x, p.y, self.nl.start, self.nl.nbr, *self.walls_near[:2],
                               self.seg, self.blocked)
 
     def _solve_density(self) -> None:

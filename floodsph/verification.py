@@ -43,6 +43,10 @@ class CaseResult:
     l1: float
     front_error_m: float
     mass_error_rel: float
+    refinement: str = "none"
+    particles_max: int = 0
+    splits: int = 0
+    merges: int = 0
 
     @property
     def particle_steps_per_s(self) -> float:
@@ -53,7 +57,12 @@ class CaseResult:
         return self.interactions / self.wall_s
 
 
-def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **numerics):
+def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, refinement=None,
+                   **numerics):
+    """A FloodModel on an analytic bed with particles on a lattice of spacing dx where the
+    depth exceeds 1 mm; ``refinement`` (a ``floodsph.refinement.Refinement``) adds a refiner."""
+    from floodsph.refinement import Refiner
+
     terrain = Terrain.from_function(bed, xlim, ylim, cell)
     X, Y = np.meshgrid(np.arange(dx / 2, terrain.width, dx), np.arange(dx / 2, terrain.height, dx))
     x, y = X.ravel(), Y.ravel()
@@ -66,7 +75,8 @@ def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **nume
              else u,
              v=np.broadcast_to(v(x + terrain.x0, y + terrain.y0), x.shape)[wet] if callable(v)
              else v)
-    return FloodModel(terrain, p, Numerics(spacing=dx, kappa=kappa, **numerics))
+    refiner = Refiner(refinement, dx) if refinement is not None and refinement.splits else None
+    return FloodModel(terrain, p, Numerics(spacing=dx, kappa=kappa, **numerics), refiner=refiner)
 
 
 def _run(model, t_end):
@@ -81,6 +91,13 @@ def _run(model, t_end):
     return time.perf_counter() - t0, pst, pairs
 
 
+def _refinement_counts(refinement, model) -> tuple:
+    """(mode, particles_max, splits, merges) of a finished run, for ``CaseResult``."""
+    c = model.counters
+    mode = "none" if refinement is None else refinement.mode
+    return mode, c["particles_max"], c["splits"], c["merges"]
+
+
 def _depth_at(model, qx, qy):
     p = model.particles
     d = interpolate(qx, qy, p.x, p.y, p.u, p.v, p.m, p.rho, p.h)[0]
@@ -93,11 +110,13 @@ def _channel_profile(model, xq):
     return _depth_at(model, X.ravel(), Y.ravel()).reshape(X.shape).mean(axis=0)
 
 
-def ritter(dx: float, kappa: float = 1.3, **numerics) -> CaseResult:
-    """Dry-bed dam break (Ritter), d0 = 10 m, t = 50 s."""
+def ritter(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseResult:
+    """Dry-bed dam break (Ritter), d0 = 10 m, t = 50 s; ``refinement`` a ``Refinement``
+    (default: uniform resolution)."""
     d0, t_end = 10.0, 50.0
     model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
-                           lambda x, y: np.where(x < 1000, d0, 0.0), dx, kappa, **numerics)
+                           lambda x, y: np.where(x < 1000, d0, 0.0), dx, kappa,
+                           refinement=refinement, **numerics)
     v0 = model.volume()
     wall, pst, pairs = _run(model, t_end)
     xq = np.arange(0.5, 2000, 1.0)
@@ -106,14 +125,15 @@ def ritter(dx: float, kappa: float = 1.3, **numerics) -> CaseResult:
     front = exact.front_position(xq, d, 0.1) - exact.front_position(xq, d_ex, 0.1)
     return CaseResult("ritter", dx, model.particles.n, model.steps, wall, pst, pairs,
                       exact.l1_relative(d, d_ex), float(front),
-                      abs(model.volume() - v0) / v0)
+                      abs(model.volume() - v0) / v0, *_refinement_counts(refinement, model))
 
 
-def stoker(dx: float, kappa: float = 1.3, **numerics) -> CaseResult:
+def stoker(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseResult:
     """Wet-bed dam break (Stoker), 10 m over 2 m, t = 50 s."""
     d_l, d_r, t_end = 10.0, 2.0, 50.0
     model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
-                           lambda x, y: np.where(x < 1000, d_l, d_r), dx, kappa, **numerics)
+                           lambda x, y: np.where(x < 1000, d_l, d_r), dx, kappa,
+                           refinement=refinement, **numerics)
     v0 = model.volume()
     wall, pst, pairs = _run(model, t_end)
     xq = np.arange(0.5, 2000, 1.0)
@@ -125,10 +145,11 @@ def stoker(dx: float, kappa: float = 1.3, **numerics) -> CaseResult:
     front = bore - exact.stoker_bore_position(t_end, d_l, d_r, x_dam=1000.0)
     return CaseResult("stoker", dx, model.particles.n, model.steps, wall, pst, pairs,
                       exact.l1_relative(d, d_ex), float(front),
-                      abs(model.volume() - v0) / v0)
+                      abs(model.volume() - v0) / v0, *_refinement_counts(refinement, model))
 
 
-def thacker(dx: float, kappa: float = 1.3, periods: float = 1.0, **numerics) -> CaseResult:
+def thacker(dx: float, kappa: float = 1.3, periods: float = 1.0, refinement=None,
+            **numerics) -> CaseResult:
     """Thacker's planar surface in a paraboloid, frictionless, over ``periods`` periods."""
     h0, a, eta = 10.0, 3000.0, 1500.0
     t_end = periods * exact.thacker_period(h0, a)
@@ -136,7 +157,8 @@ def thacker(dx: float, kappa: float = 1.3, periods: float = 1.0, **numerics) -> 
         lambda x, y: h0 * (x**2 + y**2) / a**2, (-5000, 5000), (-5000, 5000), 50.0,
         lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[0], dx, kappa,
         u=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[1],
-        v=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[2], **numerics)
+        v=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[2], refinement=refinement,
+        **numerics)
     v0 = model.volume()
     wall, pst, pairs = _run(model, t_end)
     xq = np.arange(-4975.0, 5000.0, 50.0)
@@ -148,7 +170,7 @@ def thacker(dx: float, kappa: float = 1.3, periods: float = 1.0, **numerics) -> 
     r_wet = np.hypot(X.ravel() - eta, Y.ravel())[(d > 1e-3)]
     shore = float(r_wet.max() - a) if r_wet.size else np.nan
     return CaseResult("thacker", dx, model.particles.n, model.steps, wall, pst, pairs, l1,
-                      shore, abs(model.volume() - v0) / v0)
+                      shore, abs(model.volume() - v0) / v0, *_refinement_counts(refinement, model))
 
 
 CASES = {"ritter": ritter, "stoker": stoker, "thacker": thacker}

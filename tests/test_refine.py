@@ -10,7 +10,6 @@ import math
 import numpy as np
 import pytest
 
-from floodsph import testing as exact
 from floodsph import verification as cases
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
@@ -263,46 +262,25 @@ def test_split_then_merge_in_still_water_no_spurious_velocity_above_1mm_s(
 
 
 # -- in a run ------------------------------------------------------------------------------------
-def ritter(dx, refinement=None):
-    """The verification dam break (d0 = 10 m, dam at x = 1000 m, t = 50 s) with a refiner.
-
-    Returns (L1 relative error, front error [m], particle-steps, mass error, counters).
-    """
-    d0, t_end = 10.0, 50.0
-    model = cases._lattice_model(flat, (0, 2000), (0, 100), 10.0,
-                                 lambda x, y: np.where(x < 1000, d0, 0.0), dx, 1.3)
-    if refinement is not None:
-        model.refiner = Refiner(refinement, dx)
-    mass0 = model.particles.m.sum()
-    _, particle_steps, _ = cases._run(model, t_end)
-    xq = np.arange(0.5, 2000, 1.0)
-    d = cases._channel_profile(model, xq)
-    d_ex, _ = exact.ritter(xq, t_end, d0, x_dam=1000.0)
-    front = exact.front_position(xq, d, 0.1) - exact.front_position(xq, d_ex, 0.1)
-    mass_err = abs(model.particles.m.sum() - mass0) / mass0
-    return exact.l1_relative(d, d_ex), front, particle_steps, mass_err, model.counters
-
-
 def test_splitting_improves_a_coarse_dam_break():
-    l1_plain, front_plain, _, _, _ = ritter(20.0)
-    l1, front, _, mass_err, counters = ritter(20.0, Refinement())
-    assert counters["splits"] > 0
-    assert counters["particles_max"] >= 250 + 6 * counters["splits"] - 7 * counters["merges"]
-    assert mass_err < 1e-12
-    assert l1 < 0.75 * l1_plain
-    assert abs(front) < abs(front_plain)
+    plain = cases.ritter(20.0)
+    r = cases.ritter(20.0, refinement=Refinement())
+    assert r.splits > 0
+    assert r.particles_max >= 250 + 6 * r.splits - 7 * r.merges
+    assert r.mass_error_rel < 1e-12
+    assert r.l1 < 0.75 * plain.l1
+    assert abs(r.front_error_m) < abs(plain.front_error_m)
 
 
 @pytest.mark.slow
 def test_refined_dam_break_matches_the_fine_uniform_run_at_a_third_of_the_cost():
     """Coarse 10 m start with one level of splitting against a uniform run at the daughters'
     mass-equivalent spacing 10 / sqrt(7) m."""
-    fine = 10.0 / math.sqrt(7.0)
-    l1_fine, _, steps_fine, _, _ = ritter(fine)
-    l1, _, steps, mass_err, counters = ritter(10.0, Refinement(max_level=1))
-    assert counters["splits"] > 0 and mass_err < 1e-12
-    assert l1 <= 1.2 * l1_fine
-    assert steps <= steps_fine / 3
+    fine = cases.ritter(10.0 / math.sqrt(7.0))
+    r = cases.ritter(10.0, refinement=Refinement(max_level=1))
+    assert r.splits > 0 and r.mass_error_rel < 1e-12
+    assert r.l1 <= 1.2 * fine.l1
+    assert r.particle_steps <= fine.particle_steps / 3
 
 
 def test_split_daughters_relax_to_sqrt3_lattice_smoothing_and_lattice_particles_stay():

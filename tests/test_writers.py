@@ -165,3 +165,13 @@ def test_pictures_are_written_or_skipped_with_a_message(envelopes, tmp_path, mon
                                              "hazard_uk.png", "max_depth.png"]
     monkeypatch.setitem(__import__("sys").modules, "matplotlib", None)
     assert write_pictures(envelopes, tmp_path) == "pictures skipped: matplotlib not installed"
+
+
+def test_result_tables_format_floats_and_nan(tmp_path):
+    from floodsph.output.tables import markdown, write_csv
+
+    rows = [{"case": "a", "wall_s": np.float64(12.3456789), "l1": float("nan"), "n": 3}]
+    path = write_csv(tmp_path / "t.csv", rows, spec=".3f")
+    assert path.read_text().splitlines() == ["case,wall_s,l1,n", "a,12.346,nan,3"]
+    assert markdown(rows, ["case", "wall_s"]).splitlines() == [
+        "| case | wall_s |", "|---|---|", "| a | 12.35 |"]

@@ -1,14 +1,27 @@
-"""Speed against error of floodsph on the analytic cases, and raw solver throughput.
+"""Speed against error of floodsph: analytic cases, real terrain, and raw solver throughput.
 
-Runs Ritter and Stoker dam breaks and Thacker's basin at three spacings each through the real
-solver (``floodsph.verification``), plus the throughput of two ~100,000-particle blocks
-(kappa 1.3, about 21 interacting neighbours per particle): still water in a closed box (the
-neighbour lists are kept from step to step) and a dam break on a sloping bed (fast flow: the
-lists are rebuilt every step or two). Writes ``speed_vs_error.csv`` and ``speed_vs_error.png``
-(error against wall time) into the results folder and prints the table. Timings are
-wall-clock on this machine: compare rows of one run, not runs on different days.
+* **Analytic cases** (``floodsph.verification``): Ritter and Stoker dam breaks and Thacker's
+  basin at three spacings each, in each refinement mode (default ``none`` and
+  ``split+coalesce``); the error is the L1 relative depth error against the exact solution.
+* **Real cases**: Malpasset (``workflows/malpasset/scenario.toml``, 1000 s, the sea as
+  particles) and EA Test 4 (``workflows/ea_test4``, 18000 s) at three particle spacings in
+  each mode, through the real run chain (run folders, maps). Their observed values are held
+  back, so the error is against the finest ``split+coalesce`` run of the case (the
+  reference): CSI of the max-depth maps (wet = 0.1 m) and depth RMSE where both are wet.
+  The data is read from ``$FLOODSPH_BENCHMARKS`` (or ``<repo>/../shared/benchmarks``); a case
+  whose data is absent is skipped with a message.
+* **Throughput** of two ~100,000-particle blocks (kappa 1.3, about 21 interacting neighbours
+  per particle): still water in a closed box (the neighbour lists are kept from step to step)
+  and a dam break on a sloping bed (fast flow: the lists are rebuilt every step or two).
+
+Writes into the results folder ``speed_vs_error.csv`` (analytic and throughput rows),
+``real_cases.csv``, ``speed_vs_error.png`` (error against wall time, one panel per case: the
+Pareto view) and ``speed_vs_error.md`` (the report, with the command that made it). Timings
+are wall-clock on this machine: compare rows of one run, not runs on different days.
 
     python workflows/speed_vs_error.py [--out results/speed_vs_error] [--quick]
+        [--cases ritter stoker thacker malpasset ea_test4] [--modes none split+coalesce]
+        [--max-steps N] [--no-throughput]
     python workflows/speed_vs_error.py --throughput-only [--repeats 5] [--skin 0.3]
 
 Throughput: every kernel is compiled on a small block first, the big block is built and
@@ -20,22 +33,31 @@ interactions (directed pairs with r < 2 max(h_i, h_j)) are counted between steps
 from __future__ import annotations
 
 import argparse
-import csv
 import math
+import os
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from floodsph import verification as cases
-from floodsph.constants import RHO_WATER
-from floodsph.model import FloodModel, Numerics
-from floodsph.particles import ParticleSet
-from floodsph.terrain import Terrain
+sys.path.insert(0, str(Path(__file__).resolve().parent / "malpasset"))
+sys.path.insert(0, str(Path(__file__).resolve().parent / "ea_test4"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-SPACINGS = {"ritter": (10.0, 5.0, 2.5), "stoker": (10.0, 5.0, 2.5),
-            "thacker": (200.0, 100.0, 50.0)}
-QUICK = {"ritter": (10.0,), "stoker": (10.0,), "thacker": (200.0,)}
+import malpasset_setup as mp_setup  # noqa: E402
+import run_ea_test4 as ea4  # noqa: E402
+import scenario_runs as runs  # noqa: E402
+
+from floodsph import verification as cases  # noqa: E402
+from floodsph.constants import RHO_WATER  # noqa: E402
+from floodsph.model import FloodModel, Numerics  # noqa: E402
+from floodsph.output.tables import markdown, write_csv  # noqa: E402
+from floodsph.particles import ParticleSet  # noqa: E402
+from floodsph.terrain import Terrain  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+
 BLOCK_SIDE = 316
 """Particles per side of the throughput blocks (316^2 = 99,856)."""
 
@@ -88,40 +110,118 @@ def throughput(kind: str, n_side: int = BLOCK_SIDE, steps: int = 10, repeats: in
     return row, builds / steps
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path("results/speed_vs_error"))
     ap.add_argument("--quick", action="store_true", help="one coarse spacing per case")
-    ap.add_argument("--throughput-only", action="store_true", help="skip the analytic cases")
+    ap.add_argument("--cases", nargs="+", choices=[*ANALYTIC, *REAL], default=[*ANALYTIC, *REAL])
+    ap.add_argument("--modes", nargs="+", choices=MODES, default=["none", "split+coalesce"])
+    ap.add_argument("--max-steps", type=int, default=None, help="real cases: stop after N steps")
+    ap.add_argument("--throughput-only", action="store_true", help="only the throughput blocks")
+    ap.add_argument("--no-throughput", action="store_true", help="skip the throughput blocks")
     ap.add_argument("--repeats", type=int, default=3, help="timed blocks per throughput case")
     ap.add_argument("--skin", type=float, default=None, help="neighbour_skin of the blocks")
-    args = ap.parse_args()
-    args.out.mkdir(parents=True, exist_ok=True)
-    rows = []
+    args = ap.parse_args(argv)
+    out = args.out.resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    rows, real = [], []
     if not args.throughput_only:
-        cases.ritter(20.0)  # compile every kernel once, outside the timings
-        for name, spacings in (QUICK if args.quick else SPACINGS).items():
-            for dx in spacings:
-                rows.append(cases.CASES[name](dx))
-                print_row(rows[-1])
-    numerics = {} if args.skin is None else {"neighbour_skin": args.skin}
-    side = 100 if args.quick else BLOCK_SIDE
+        names = [c for c in args.cases if c in ANALYTIC]
+        if names:
+            cases.ritter(20.0)  # compile every kernel once, outside the timings
+        for name in names:
+            for dx in (QUICK if args.quick else SPACINGS)[name]:
+                for mode in args.modes:
+                    rows.append(cases.CASES[name](dx, refinement=_refinement(mode)))
+                    print_row(rows[-1])
+        for name in (c for c in args.cases if c in REAL):
+            real += real_case(name, out / name, args.modes, args.quick, args.max_steps)
     speed = []
-    for kind in ("still", "dam-break"):
-        row, builds = throughput(kind, side, repeats=args.repeats, **numerics)
-        rows.append(row)
-        speed.append((row, builds))
-        print_row(row)
-    print_throughput(speed)
-    write_csv(args.out / "speed_vs_error.csv", rows)
-    if not args.throughput_only:
-        plot(args.out / "speed_vs_error.png", rows)
+    if not args.no_throughput:
+        numerics = {} if args.skin is None else {"neighbour_skin": args.skin}
+        side = 100 if args.quick else BLOCK_SIDE
+        for kind in ("still", "dam-break"):
+            row, builds = throughput(kind, side, repeats=args.repeats, **numerics)
+            rows.append(row)
+            speed.append((row, builds))
+            print_row(row)
+        print_throughput(speed)
+    if rows:
+        write_csv(out / "speed_vs_error.csv",
+                  [{k: getattr(r, k) for k in CSV_COLUMNS} for r in rows], CSV_COLUMNS)
+    if real:
+        write_csv(out / "real_cases.csv", real, REAL_COLUMNS)
+    analytic = [r for r in rows if r.case in ANALYTIC]
+    picture = plot(out / "speed_vs_error.png", analytic, real)
+    (out / "speed_vs_error.md").write_text(report(analytic, real, speed, picture, argv))
+    print(f"report: {out / 'speed_vs_error.md'}")
+
+
+def _refinement(mode: str):
+    """The ``Refinement`` of a mode (None for uniform resolution)."""
+    from floodsph.refinement import Refinement
+
+    return None if mode == "none" else Refinement(mode=mode)
+
+
+def real_scenario(case: str, out: Path):
+    """(scenario path, DEM path or None) of a real case, or None when its data is absent."""
+    if case == "malpasset":
+        folder = mp_setup.data_folder()
+        if folder is None:
+            print("malpasset: skipped, benchmark data not found (set FLOODSPH_BENCHMARKS)")
+            return None
+        return REPO / "workflows" / "malpasset" / "scenario.toml", folder / mp_setup.DEM_NAME
+    folder = ea4.data_folder()
+    if folder is None:
+        print("ea_test4: skipped, benchmark data not found (set FLOODSPH_BENCHMARKS)")
+        return None
+    out.mkdir(parents=True, exist_ok=True)
+    return ea4.write_inputs(folder, out, ea4.END_TIME_S, 5, 5.0), None
+
+
+def real_case(case: str, out: Path, modes, quick: bool, max_steps: int | None) -> list[dict]:
+    """Runs of a real case at its spacings in each mode, with their agreement with the
+    finest ``split+coalesce`` run (or the finest run of the first mode without it)."""
+    source = real_scenario(case, out)
+    if source is None:
+        return []
+    path, dem = source
+    spacings = REAL[case]["spacings"][:1] if quick else REAL[case]["spacings"]
+    rows = []
+    for dx in spacings:
+        for mode in modes:
+            folder = out / f"{mode}_{dx:g}m"
+            scenario = runs.variant(path, folder, mode, dx, REAL[case]["end_time"], dem=dem)
+            rows.append(runs.run(scenario, folder, max_steps, case=case) | {"run": folder})
+    ref_mode = "split+coalesce" if "split+coalesce" in modes else modes[0]
+    ref = min((r for r in rows if r["mode"] == ref_mode), key=lambda r: r["spacing_m"])
+    name, ref_run = f"{ref_mode} {ref['spacing_m']:g} m", ref["run"]
+    for r in rows:
+        r.update(reference=name, **runs.agreement(r.pop("run"), ref_run))
+    return rows
+
+
+SPACINGS = {"ritter": (10.0, 5.0, 2.5), "stoker": (10.0, 5.0, 2.5),
+            "thacker": (200.0, 100.0, 50.0)}
+QUICK = {"ritter": (10.0,), "stoker": (10.0,), "thacker": (200.0,)}
+ANALYTIC = tuple(SPACINGS)
+REAL = {"malpasset": {"spacings": (80.0, 60.0, 40.0), "end_time": 1000.0},
+        "ea_test4": {"spacings": (20.0, 10.0, 5.0), "end_time": ea4.END_TIME_S}}
+MODES = ("none", "split", "split+coalesce")
+CSV_COLUMNS = ["case", "refinement", "spacing", "particles", "particles_max", "steps", "wall_s",
+               "l1", "front_error_m", "mass_error_rel", "particle_steps_per_s",
+               "interactions_per_s"]
+REAL_COLUMNS = ["case", "mode", "spacing_m", "wall_s", "sim_time_s", "steps",
+                "particles_initial", "particles_max", "particle_steps", "splits", "merges",
+                "mass_error_rel", "reference", "csi", "rmse_m", "bias_m"]
 
 
 def print_row(r: cases.CaseResult) -> None:
-    print(f"{r.case:10s} dx={r.spacing:7.1f} n={r.particles:7d} steps={r.steps:5d} "
-          f"wall={r.wall_s:8.2f}s L1={r.l1:.4f} front_err={r.front_error_m:8.1f}m "
-          f"mass_err={r.mass_error_rel:.1e} particle-steps/s={r.particle_steps_per_s:,.0f} "
+    print(f"{r.case:10s} {r.refinement:14s} dx={r.spacing:7.1f} n={r.particles:7d} "
+          f"steps={r.steps:5d} wall={r.wall_s:8.2f}s L1={r.l1:.4f} "
+          f"front_err={r.front_error_m:8.1f}m mass_err={r.mass_error_rel:.1e} "
+          f"particle-steps/s={r.particle_steps_per_s:,.0f} "
           f"interactions/s={r.interactions_per_s:,.0f} "
           f"neighbours/particle={r.interactions / max(r.particle_steps, 1):.1f}", flush=True)
 
@@ -136,17 +236,41 @@ def print_throughput(speed) -> None:
               f"{r.interactions / r.particle_steps:10.1f} {builds:16.2f}")
 
 
-def write_csv(path: Path, rows) -> None:
-    fields = ["case", "spacing", "particles", "steps", "wall_s", "l1", "front_error_m",
-              "mass_error_rel", "particle_steps_per_s", "interactions_per_s"]
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(fields)
-        for r in rows:
-            w.writerow([getattr(r, k) for k in fields])
+def report(analytic, real, speed, picture, argv) -> str:
+    """The markdown report: the command, the three tables and the picture."""
+    command = " ".join(["python workflows/speed_vs_error.py", *(argv or sys.argv[1:])])
+    lines = ["# floodsph: speed against error", "",
+             f"Made by `{command}` on {time.strftime('%Y-%m-%d')}, "
+             f"{os.cpu_count()} cores. Wall times are of this machine and this run: compare "
+             "rows, not runs.", ""]
+    if analytic:
+        lines += ["## Analytic cases (error against the exact solution)", "",
+                  markdown([{"case": r.case, "refinement": r.refinement, "spacing m": r.spacing,
+                             "peak particles": r.particles_max, "steps": r.steps,
+                             "wall s": r.wall_s, "L1": r.l1, "front error m": r.front_error_m,
+                             "mass error": r.mass_error_rel} for r in analytic]), ""]
+    if real:
+        lines += ["## Real terrain (agreement with the finest split+coalesce run)", "",
+                  "Observed values are held back; `csi` and `rmse_m` compare each run's "
+                  "max-depth map with the reference run's (wet = 0.1 m; RMSE over cells wet "
+                  "in both).", "",
+                  markdown([{k: r[k] for k in ("case", "mode", "spacing_m", "wall_s",
+                                               "particles_max", "particle_steps",
+                                               "mass_error_rel", "csi", "rmse_m")}
+                            for r in real]), ""]
+    if speed:
+        lines += ["## Throughput (about 100,000 particles, about 20 neighbours)", "",
+                  markdown([{"block": r.case, "particles": r.particles,
+                             "particle-steps/s": r.particle_steps_per_s,
+                             "interactions/s": r.interactions_per_s,
+                             "list builds/step": builds} for r, builds in speed]), ""]
+    if picture is not None:
+        lines += [f"![error against wall time]({picture.name})", ""]
+    return "\n".join(lines)
 
 
-def plot(path: Path, rows) -> None:
+def plot(path: Path, analytic, real) -> Path | None:
+    """Error against wall time, one log-log panel per case, one line per mode."""
     try:
         import matplotlib
 
@@ -154,20 +278,39 @@ def plot(path: Path, rows) -> None:
         import matplotlib.pyplot as plt
     except ImportError:
         print("plot skipped: matplotlib not installed")
-        return
-    fig, ax = plt.subplots(figsize=(7, 5))
-    for name in ("ritter", "stoker", "thacker"):
-        sel = [r for r in rows if r.case == name]
-        if sel:
-            ax.loglog([r.wall_s for r in sel], [r.l1 for r in sel], "o-", label=name)
-            for r in sel:
-                ax.annotate(f"{r.spacing:g} m", (r.wall_s, r.l1), fontsize=8)
-    ax.set_xlabel("wall time [s] (2 cores)")
-    ax.set_ylabel("L1 relative depth error")
-    ax.set_title("floodsph: error against wall time")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.savefig(path, dpi=100, bbox_inches="tight")
+        return None
+    series = []
+    for name in ANALYTIC:
+        for mode in MODES:
+            sel = [(r.wall_s, r.l1, r.spacing) for r in analytic
+                   if r.case == name and r.refinement == mode]
+            series.append((name, "L1 relative depth error", mode, sel))
+    for name in REAL:
+        for mode in MODES:
+            sel = [(r["wall_s"], r["rmse_m"], r["spacing_m"]) for r in real
+                   if r["case"] == name and r["mode"] == mode and r["rmse_m"] > 0]
+            series.append((name, "max-depth RMSE vs reference [m]", mode, sel))
+    panels = [n for n in (*ANALYTIC, *REAL) if any(s[0] == n and s[3] for s in series)]
+    if not panels:
+        return None
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.8), squeeze=False)
+    for ax, name in zip(axes[0], panels, strict=True):
+        for case, label, mode, sel in series:
+            if case != name or not sel:
+                continue
+            wall, err, dx = zip(*sel, strict=True)
+            ax.loglog(wall, err, "o-" if mode == "none" else "s--", label=mode)
+            for w, e, d in sel:
+                ax.annotate(f"{d:g} m", (w, e), fontsize=7)
+            ax.set_ylabel(label)
+        ax.set_title(name)
+        ax.set_xlabel("wall time [s]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
 
 
 if __name__ == "__main__":

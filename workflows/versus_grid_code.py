@@ -41,7 +41,6 @@ Usage: ``python workflows/versus_grid_code.py [SCENARIO ...] [--end-time S] [--t
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
 import importlib.util
 import os
@@ -51,6 +50,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from floodsph.output.tables import write_csv
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_SCENARIO = REPO / "data_samples" / "valley" / "scenario.toml"
@@ -340,15 +341,6 @@ def plot_side_by_side(path: Path, result, reference_on_model: np.ndarray) -> Pat
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
-    return path
-
-
-def write_csv(path: Path, rows: list[dict]) -> Path:
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()}
-                    for r in rows)
     return path
 
 

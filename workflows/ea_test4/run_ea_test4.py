@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.output.tables import write_csv
+
 REPO = Path(__file__).resolve().parents[2]
 DEM_NAMES = {5: "ea4_dem_5m.asc", 10: "ea4_dem_10m.asc"}
 HYDROGRAPH_NAME = "ea4_inflow_hydrograph.csv"
@@ -168,15 +170,6 @@ def volume_balance(manifest: dict, hydrograph) -> dict:
             "mass_error_rel": manifest["mass_error_rel"], "steps": manifest["steps"],
             "particles_final": manifest["particles_final"],
             "wall_time_s": manifest["wall_time_s"]}
-
-
-def write_csv(path: Path, rows: list[dict]) -> Path:
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()}
-                    for r in rows)
-    return path
 
 
 def plot_depths(path: Path, run: Path, points) -> Path | None:

@@ -117,17 +117,6 @@ def point_table(run_dir: Path, dem: Path, points: list[dict], sea: str) -> list[
     return out
 
 
-def write_rows(path: Path, columns, rows: list[dict]) -> Path:
-    """A CSV of ``rows`` (dicts) with ``columns``; floats with 3 decimals, NaN as ``nan``."""
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(columns)
-        for row in rows:
-            w.writerow([f"{row[c]:.3f}" if isinstance(row[c], float | np.floating)
-                        else row[c] for c in columns])
-    return path
-
-
 def cost_row(run_dir: Path, sea: str, peak_rss_mb: float) -> dict:
     """COST_COLUMNS of one run from its ``run.json`` plus the process peak memory [MB]."""
     run = json.loads((run_dir / "run.json").read_text())

@@ -35,6 +35,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import malpasset_results as results  # noqa: E402
 import malpasset_setup as setup  # noqa: E402
 
+from floodsph.output.tables import write_csv  # noqa: E402
+
 DEFAULT_OUT = setup.REPO / "workflows" / "malpasset" / "results"
 PARTICLE_COUNT_INTERVAL_S = 10.0
 
@@ -61,7 +63,7 @@ def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_T
     points = setup.read_points(folder)
     dem = folder / setup.DEM_NAME
     rows = results.point_table(run_dir, dem, points, sea)
-    results.write_rows(where / "points.csv", results.POINT_COLUMNS, rows)
+    write_csv(where / "points.csv", rows, results.POINT_COLUMNS, ".3f")
     cost = results.cost_row(run_dir, sea, peak_mb)
     (where / "cost.json").write_text(json.dumps(cost, indent=2) + "\n")
     results.plot_max_level(run_dir, dem, points, where / "max_level.png",
@@ -90,8 +92,8 @@ def summarise(out: Path) -> tuple[list[dict], list[dict]]:
             points += list(csv.DictReader(f))
         curves[sea] = out / sea / "particles.csv"
     if costs:
-        results.write_rows(out / "malpasset_points.csv", results.POINT_COLUMNS, points)
-        results.write_rows(out / "malpasset_costs.csv", results.COST_COLUMNS, costs)
+        write_csv(out / "malpasset_points.csv", points, results.POINT_COLUMNS, ".3f")
+        write_csv(out / "malpasset_costs.csv", costs, results.COST_COLUMNS, ".3f")
         results.plot_particles(curves, out / "particles.png")
     return points, costs
 

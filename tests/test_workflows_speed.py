@@ -1,0 +1,77 @@
+"""``workflows/speed_vs_error.py`` and ``workflows/refinement_benchmark.py``, run briefly.
+
+The analytic part runs the coarse Stoker dam break in both default modes; the real cases
+(third-party data, skipped when absent) run two steps per mode at their coarsest spacing,
+which checks the chain: run folders, the agreement with the reference run, the CSV, the
+markdown report and the picture.
+"""
+
+from __future__ import annotations
+
+import csv
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+WORKFLOWS = REPO / "workflows"
+
+
+def _load(name: str, path: Path):
+    if str(path.parent) not in sys.path:
+        sys.path.insert(0, str(path.parent))
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+speed = _load("speed_vs_error", WORKFLOWS / "speed_vs_error.py")
+bench = _load("refinement_benchmark", WORKFLOWS / "refinement_benchmark.py")
+
+
+def _rows(path: Path) -> list[dict]:
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_speed_vs_error_analytic_rows_and_report(tmp_path):
+    speed.main(["--quick", "--cases", "stoker", "--no-throughput", "--out", str(tmp_path)])
+    rows = _rows(tmp_path / "speed_vs_error.csv")
+    assert [(r["case"], r["refinement"], r["spacing"]) for r in rows] == [
+        ("stoker", "none", "10"), ("stoker", "split+coalesce", "10")]
+    for r in rows:
+        assert 0.0 < float(r["l1"]) < 0.015  # the coarse Stoker target of the core tests
+        assert abs(float(r["front_error_m"])) <= 20.0 and float(r["mass_error_rel"]) < 1e-12
+    report = (tmp_path / "speed_vs_error.md").read_text()
+    assert "| stoker | none | 10 |" in report and "speed_vs_error.png" in report
+    assert (tmp_path / "speed_vs_error.png").stat().st_size > 10_000
+
+
+def test_speed_vs_error_real_cases_agree_with_their_reference(tmp_path):
+    if speed.mp_setup.data_folder() is None and speed.ea4.data_folder() is None:
+        pytest.skip("benchmark data not found (set FLOODSPH_BENCHMARKS)")
+    speed.main(["--quick", "--cases", "malpasset", "ea_test4", "--max-steps", "2",
+                "--no-throughput", "--out", str(tmp_path)])
+    rows = _rows(tmp_path / "real_cases.csv")
+    assert {r["mode"] for r in rows} == {"none", "split+coalesce"}
+    for r in rows:
+        assert r["reference"] == f"split+coalesce {r['spacing_m']} m"
+        assert int(r["steps"]) == 2 and float(r["mass_error_rel"]) < 1e-12
+        if r["mode"] == "split+coalesce":  # the reference against itself
+            assert r["csi"] in ("1", "nan") and r["rmse_m"] in ("0", "nan")
+    assert "## Real terrain" in (tmp_path / "speed_vs_error.md").read_text()
+
+
+def test_refinement_benchmark_two_steps_on_the_valley(tmp_path):
+    bench.main(["--cases", "valley", "--modes", "none", "split", "--max-steps", "2",
+                "--out", str(tmp_path)])
+    rows = _rows(tmp_path / "refinement_benchmark.csv")
+    assert [r["mode"] for r in rows] == ["none", "split"]
+    assert all(int(r["steps"]) == 2 and float(r["mass_error_rel"]) < 1e-12 for r in rows)
+    (pair,) = _rows(tmp_path / "agreement.csv")
+    assert (pair["mode"], pair["against"]) == ("split", "none")
+    assert float(pair["csi"]) > 0.99  # two steps: the same water in both
