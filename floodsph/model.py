@@ -111,10 +111,10 @@ class FloodModel:
         h0 = numerics.kappa * numerics.spacing
         segs = [wallmod.segments_from_polylines(walls),
                 _side_segments(terrain, closed, extension=6.0 * h0)]
+        openings = [b.opening for b in self.boundaries if hasattr(b, "opening")]
         if closed_edges is not False:
             segs.append(wallmod.segments_from_polylines(
-                nodata_polylines(terrain.valid, terrain.dx, terrain.dy)))
-        openings = [b.opening for b in self.boundaries if hasattr(b, "opening")]
+                nodata_polylines(terrain.valid, terrain.dx, terrain.dy, openings)))
         self.seg = cut_openings(np.concatenate(segs), openings, 1e-6 * numerics.spacing)
         self.wall_index = wallmod.WallIndex(
             self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=2.0 * h0)
@@ -129,11 +129,8 @@ class FloodModel:
         self._blocked_nl = None
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
-        n = particles.n
-        particles.x[:n], particles.y[:n] = settle_seeds(
-            particles.x[:n], particles.y[:n], terrain.valid, terrain.dx, terrain.dy,
-            numerics.spacing)
-        self._remove_outside(nodata=True)
+        self._settle_seeds()
+        self._remove_outside(nodata=closed_edges is False)
         self._interactions()
         self.dt = self.stable_dt()
 
@@ -221,10 +218,22 @@ class FloodModel:
         self._forces()
         p.truncate(water)
 
+    def _settle_seeds(self) -> None:
+        """Move seeds off nodata and off wall lines (``settle_seeds``); those that cannot be
+        moved are removed and counted as outflow."""
+        p, t = self.particles, self.terrain
+        walled = self.closed_edges is not False
+        x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy, self.numerics.spacing,
+                                  self.seg if walled else None)
+        p.x[:], p.y[:] = x, y
+        if lost.any():
+            self.volume_out += float(p.m[lost].sum() / RHO_WATER)
+            p.keep(~lost)
+
     def _remove_outside(self, nodata: bool) -> None:
         """Remove (and count as outflow) particles off the grid, and in nodata cells if
-        ``nodata``: always at construction, and in a step when nodata is not walled off (the
-        walled nodata border runs through nodata cells, whose slivers are then wet area)."""
+        ``nodata``, i.e. when nodata is not walled off (the walled nodata border runs through
+        nodata cells, whose slivers are then wet area)."""
         p = self.particles
         t = self.terrain
         ny, nx = t.shape

@@ -194,7 +194,9 @@ class Refiner:
         if idx.size == 0:
             return idx
         x, y, _ = self._daughter_positions(p, idx)
-        ok = _on_terrain(model.terrain, x, y).reshape(-1, refine.DAUGHTERS).all(axis=1)
+        walled = model.closed_edges is not False
+        ok = _on_terrain(model.terrain, x, y, nodata_ok=walled)
+        ok = ok.reshape(-1, refine.DAUGHTERS).all(axis=1)
         wi = model.wall_index
         if wi.seg.shape[0]:
             clear = np.empty(idx.size, dtype=np.bool_)
@@ -293,11 +295,14 @@ def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE) -> None:
         p.h[over] *= f
 
 
-def _on_terrain(terrain, x, y) -> np.ndarray:
-    """True for points on a valid cell of the terrain grid (local coordinates)."""
+def _on_terrain(terrain, x, y, nodata_ok: bool) -> np.ndarray:
+    """True for points on the terrain grid (local coordinates), and on a valid cell unless
+    ``nodata_ok`` (nodata walled off: its slivers inside the walls are wet area, and
+    ``daughters_clear`` keeps daughters on their parent's side of every wall)."""
     ny, nx = terrain.shape
     col = np.floor(x / terrain.dx).astype(np.int64)
     row = np.floor(y / terrain.dy).astype(np.int64)
     inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
-    inside[inside] = terrain.valid[row[inside], col[inside]]
+    if not nodata_ok:
+        inside[inside] = terrain.valid[row[inside], col[inside]]
     return inside

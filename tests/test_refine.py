@@ -221,6 +221,30 @@ def kinetic_energy(p):
     return float(np.sum(0.5 * p.m * (p.u**2 + p.v**2)))
 
 
+def test_split_then_merge_operators_create_no_spurious_velocity():
+    """Splitting a patch of a uniformly moving sheet and merging its daughters back, with no
+    time step between, leaves every particle with the sheet's velocity to round-off: the
+    operators themselves create no velocity (the pressure response of the new arrangement is
+    the next two tests' subject)."""
+    model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
+    p = model.particles
+    p.u[:], p.v[:] = 1.3, -0.4
+    n0, mass0 = p.n, p.m.sum()
+    Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0).execute(
+        model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
+    assert p.n > n0
+    merger = Refiner(Refinement(area_max=3.0, area_min=0.3, no_merge_steps=0), 1.0)
+    merges = 0
+    for _ in range(10):
+        a, b = merger.merge_pairs(model)
+        if a.size == 0:
+            break
+        merges += merger.execute(model, [], a, b)[1]
+    assert merges > 40
+    assert np.abs(p.u - 1.3).max() < 1e-12 and np.abs(p.v + 0.4).max() < 1e-12
+    assert abs(p.m.sum() - mass0) < 1e-12 * mass0
+
+
 @pytest.fixture(scope="module")
 def pond_after_split_and_merge():
     """A 1 m deep still pond: a patch split, its daughters merged back over 30 steps, then

@@ -7,10 +7,11 @@ over steps of the particle count, the solver's work measure), splits, merges and
 error; and, for each pair of modes, the agreement of their ``max_depth.tif`` maps
 (``floodsph.compare``: CSI with wet = depth > 0.1 m, and RMSE / bias over cells wet in both).
 
-Scenarios: ``data_samples/valley/scenario.toml`` (its own end time, 600 s) and
-``workflows/malpasset/scenario.toml`` cut to 1000 s. Malpasset's DEM is third-party data read
-from ``$FLOODSPH_BENCHMARKS/malpasset`` or ``<repo>/../shared/benchmarks/malpasset``; the case
-is skipped with a message when it is absent.
+Scenarios: ``data_samples/valley/scenario.toml`` (its own end time, 600 s) and Malpasset
+(the scenario of ``workflows/malpasset``, the sea as particles, cut to 1000 s), written from
+the third-party data read from ``$FLOODSPH_BENCHMARKS/malpasset`` or
+``<repo>/../shared/benchmarks/malpasset``; the case is skipped with a message when it is
+absent.
 
 Writes ``refinement_benchmark.csv`` and ``agreement.csv`` into ``--out`` and prints both as
 markdown tables. Wall times depend on the machine's load: compare the ratios within one run.
@@ -23,38 +24,41 @@ markdown tables. Wall times depend on the machine's load: compare the ratios wit
 from __future__ import annotations
 
 import argparse
-import os
+import sys
 from pathlib import Path
 
-import scenario_runs as runs
+sys.path.insert(0, str(Path(__file__).resolve().parent / "malpasset"))
 
-from floodsph.output.tables import markdown, write_csv
+import malpasset_setup as mp_setup  # noqa: E402
+import scenario_runs as runs  # noqa: E402
+
+from floodsph.output.tables import markdown, write_csv  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 MODES = ("none", "split", "split+coalesce")
-CASES = {
-    "valley": (REPO / "data_samples" / "valley" / "scenario.toml", None),
-    "malpasset": (REPO / "workflows" / "malpasset" / "scenario.toml", 1000.0),
-}
+CASES = {"valley": REPO / "data_samples" / "valley" / "scenario.toml", "malpasset": None}
+MALPASSET_END_S = 1000.0
 
 
 def scenario_for(case: str, mode: str, out: Path, spacing: float | None = None,
                  end_time: float | None = None, settings: dict | None = None):
-    """The case's scenario with ``mode``, its end time and ``out`` as the run folder.
+    """The case's scenario with ``mode`` and ``out`` as the run folder.
 
-    ``spacing`` [m] and ``end_time`` [s] override the scenario's particle spacing and the
-    case's end time. Returns None (after printing why) when the case's data is missing.
+    ``spacing`` [m] and ``end_time`` [s] override the scenario's particle spacing and end
+    time. Malpasset's scenario is written next to ``out`` from the benchmark data found by
+    ``malpasset_setup.data_folder`` (the sea as particles, 20 m spacing and 1000 s unless
+    overridden). Returns None (after printing why) when the case's data is missing.
     """
-    from floodsph.scenario import load_scenario
-
-    path, case_end = CASES[case]
-    dem = load_scenario(path).terrain.dem
-    if case == "malpasset" and os.environ.get("FLOODSPH_BENCHMARKS"):
-        dem = Path(os.environ["FLOODSPH_BENCHMARKS"]) / "malpasset" / dem.name
-    if not dem.is_file():
-        print(f"{case}: skipped, {dem} not found (set FLOODSPH_BENCHMARKS)")
-        return None
-    return runs.variant(path, out, mode, spacing, end_time or case_end, settings, dem)
+    path = CASES[case]
+    if case == "malpasset":
+        folder = mp_setup.data_folder()
+        if folder is None:
+            print("malpasset: skipped, benchmark data not found (set FLOODSPH_BENCHMARKS)")
+            return None
+        end_time = end_time or MALPASSET_END_S
+        path = mp_setup.write_scenario(folder, out.parent / f"{out.name}_inputs", "particles",
+                                       end_time, spacing or 20.0)
+    return runs.variant(path, out, mode, spacing, end_time, settings)
 
 
 def main(argv=None) -> None:
@@ -76,7 +80,10 @@ def main(argv=None) -> None:
         key, _, value = item.partition("=")
         if key not in runs.REFINE_KEYS:
             ap.error(f"--set {item}: key must be one of {runs.REFINE_KEYS}")
-        settings[key] = int(value) if key == "refine_max_level" else float(value)
+        try:
+            settings[key] = int(value) if key == "refine_max_level" else float(value)
+        except ValueError:
+            ap.error(f"--set {item}: {value!r} is not a number")
     rows, pairs = [], []
     for case in args.cases:
         done = []

@@ -32,12 +32,11 @@ class StepCounter:
 
 
 def variant(path: Path, out: Path, mode: str | None = None, spacing: float | None = None,
-            end_time: float | None = None, settings: dict | None = None, dem: Path | None = None):
+            end_time: float | None = None, settings: dict | None = None):
     """The scenario at ``path`` with ``out`` as its run folder and the given replacements.
 
     ``mode``: ``numerics.refinement``; ``spacing`` [m]: ``particle_spacing_m``; ``end_time``
-    [s]; ``settings``: ``[numerics]`` refinement keys (:data:`REFINE_KEYS`); ``dem``: the DEM
-    file (a benchmark DEM found elsewhere than the scenario says).
+    [s]; ``settings``: ``[numerics]`` refinement keys (:data:`REFINE_KEYS`).
     """
     from floodsph.scenario import Refinement, load_scenario
 
@@ -50,9 +49,8 @@ def variant(path: Path, out: Path, mode: str | None = None, spacing: float | Non
     info = scenario.scenario
     if end_time is not None:
         info = dataclasses.replace(info, end_time_s=end_time)
-    terrain = scenario.terrain if dem is None else dataclasses.replace(scenario.terrain, dem=dem)
     return dataclasses.replace(
-        scenario, scenario=info, terrain=terrain,
+        scenario, scenario=info,
         numerics=dataclasses.replace(scenario.numerics, **numerics),
         output=dataclasses.replace(scenario.output, directory=out))
 

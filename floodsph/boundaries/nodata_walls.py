@@ -33,12 +33,50 @@ grows by 1.2 %."""
 _LEFT = {(1, 0): (0, 1), (0, 1): (-1, 0), (-1, 0): (0, -1), (0, -1): (1, 0)}
 
 
-def nodata_polylines(valid: np.ndarray, dx: float, dy: float,
+def nodata_polylines(valid: np.ndarray, dx: float, dy: float, openings=(),
                      tolerance: float = DEFAULT_TOLERANCE_CELLS) -> list[np.ndarray]:
-    """Simplified wall polylines ((k, 2) arrays, local metres) along the nodata border."""
+    """Simplified wall polylines along the nodata border.
+
+    Parameters
+    ----------
+    valid : (ny, nx) bool array
+        False on nodata cells (row 0 south).
+    dx, dy : float
+        Cell size [m].
+    openings : sequence of (2, 2) arrays
+        Inflow sections [m, local]: a staircase run along one keeps its end vertices, so that
+        ``floodsph.boundaries.openings.cut_openings`` finds a collinear segment to cut.
+    tolerance : float
+        Largest distance [cells] of a chord from the staircase (below sqrt(2)).
+
+    Returns
+    -------
+    list of (k, 2) float arrays: polylines in local metres, valid on the left.
+    """
+    if not 0.0 <= tolerance < np.sqrt(2.0):
+        raise ValueError(f"nodata wall tolerance must be in [0, sqrt(2)) cells, got {tolerance}")
     ok = np.asarray(valid, dtype=bool)
     scale = np.array([dx, dy], dtype=np.float64)
-    return [simplify_outward(chain, ok, tolerance) * scale for chain in trace(ok)]
+    cuts = [np.asarray(o, dtype=np.float64) / scale for o in openings]
+    return [simplify_outward(chain, ok, tolerance, _pinned(chain, cuts)) * scale
+            for chain in trace(ok)]
+
+
+def _pinned(chain: np.ndarray, openings) -> np.ndarray:
+    """True for the end vertices of chain runs that lie along an opening (cell units)."""
+    pin = np.zeros(len(chain), dtype=bool)
+    for a, b in openings:
+        t = (b - a) / np.hypot(*(b - a))
+        side = (chain - a) @ np.array([-t[1], t[0]])
+        along = (chain - a) @ t
+        on = np.abs(side) < 1e-6
+        run = on[:-1] & on[1:]
+        lo = np.minimum(along[:-1], along[1:])
+        hi = np.maximum(along[:-1], along[1:])
+        run &= (hi > 1e-6) & (lo < np.hypot(*(b - a)) - 1e-6)
+        pin[:-1] |= run
+        pin[1:] |= run
+    return pin
 
 
 def trace(valid: np.ndarray) -> list[np.ndarray]:
@@ -97,44 +135,58 @@ def _drop_collinear(chain: np.ndarray) -> np.ndarray:
 
 
 def simplify_outward(chain: np.ndarray, valid: np.ndarray,
-                     tolerance: float = DEFAULT_TOLERANCE_CELLS) -> np.ndarray:
+                     tolerance: float = DEFAULT_TOLERANCE_CELLS, pinned=None) -> np.ndarray:
     """Greedy chords along a chain (cell units, valid on the left) on its nodata side.
 
     From an anchor vertex a, the chord goes to the furthest vertex b such that every vertex k
     between them lies on the chord or on its valid side (cross(b - a, k - a) >= 0, so the
     chord runs through nodata), within ``tolerance`` of it, and no valid cell lies on the
     chord's right (:func:`_chord_clear`: across a narrow nodata bay the chord would wall
-    off the valid cells beyond); b then anchors the next chord. The ends of an open chain and
-    the first vertex of a loop are kept. Returns float (cell units) vertices.
+    off the valid cells beyond, and a chord on the grid's border would double or replace the
+    side's own boundary); b then anchors the next chord. The ends of an open chain, the first
+    vertex of a loop and ``pinned`` vertices (bool per vertex) are kept. Returns float (cell
+    units) vertices.
     """
     pts = np.asarray(chain, dtype=np.float64)
+    return pts[chord_ends(pts, valid, tolerance, pinned)]
+
+
+def chord_ends(pts: np.ndarray, valid: np.ndarray, tolerance: float, pinned=None) -> list[int]:
+    """Indices of the chain vertices that :func:`simplify_outward` keeps, in order."""
+    pin = np.zeros(len(pts), dtype=bool) if pinned is None else np.asarray(pinned, dtype=bool)
     kept = [0]
     while kept[-1] < len(pts) - 1:
-        kept.append(_furthest_chord(pts, kept[-1], valid, tolerance))
-    return pts[kept]
+        kept.append(_furthest_chord(pts, kept[-1], valid, tolerance, pin))
+    return kept
 
 
-def _furthest_chord(pts: np.ndarray, a: int, valid: np.ndarray, tolerance: float) -> int:
+def _furthest_chord(pts: np.ndarray, a: int, valid: np.ndarray, tolerance: float,
+                    pinned: np.ndarray) -> int:
     """The furthest vertex b > a that :func:`simplify_outward` may join to a (at least a + 1).
 
-    In polar coordinates (r_k, phi_k) about a, with phi measured from the first edge, vertex
-    k is on the valid side of a chord of direction theta if theta <= phi_k, and within the
-    tolerance of it if theta >= phi_k - asin(tolerance / r_k). The feasible directions for a
-    chord past k form the interval [lo, hi] of these bounds over the vertices passed; b is
-    feasible if theta_b lies in it, and once the interval is empty no later b can be.
+    In polar coordinates (r_k, phi_k) about a, with phi measured from the first edge and
+    unwrapped along the chain, vertex k is on the valid side of a chord of direction theta if
+    theta <= phi_k, and within the tolerance of it if theta >= phi_k - asin(tolerance / r_k).
+    The feasible directions for a chord past k form the interval [lo, hi] of these bounds over
+    the vertices passed; b is feasible if theta_b lies in it, and once the interval is empty
+    no later b can be. A chord does not pass a pinned vertex.
     """
-    e0 = pts[a + 1] - pts[a]
-    base = np.arctan2(e0[1], e0[0])
     lo, hi = -np.inf, np.inf
     feasible = [a + 1]
+    phi, last = 0.0, None
     for k in range(a + 1, len(pts)):
         rel = pts[k] - pts[a]
         r = float(np.hypot(*rel))
         if r == 0.0:
             break
-        phi = (np.arctan2(rel[1], rel[0]) - base + np.pi) % (2.0 * np.pi) - np.pi
+        angle = float(np.arctan2(rel[1], rel[0]))
+        if last is not None:
+            phi += (angle - last + np.pi) % (2.0 * np.pi) - np.pi
+        last = angle
         if k > a + 1 and lo - 1e-12 <= phi <= hi + 1e-12:
             feasible.append(k)
+        if pinned[k]:
+            break
         hi = min(hi, phi)
         if r > tolerance:
             lo = max(lo, phi - np.arcsin(tolerance / r))
@@ -147,8 +199,9 @@ def _furthest_chord(pts: np.ndarray, a: int, valid: np.ndarray, tolerance: float
 
 
 def _chord_clear(p: np.ndarray, q: np.ndarray, valid: np.ndarray) -> bool:
-    """True if the segment p-q (cell units) has only nodata on its right: moved 1e-6 cells
-    to its right, it passes through the interior of no valid cell.
+    """True if the segment p-q (cell units) has only nodata of the grid on its right: moved
+    1e-6 cells to its right, it stays on the grid and passes through the interior of no valid
+    cell.
 
     So the chord neither crosses a valid cell nor runs along (or through the corner of) one
     that would end up on the nodata side of the wall. Each valid cell [c, c+1] x [r, r+1] in
@@ -160,6 +213,9 @@ def _chord_clear(p: np.ndarray, q: np.ndarray, valid: np.ndarray) -> bool:
     shift = 1e-6 * np.array([e[1], -e[0]]) / np.hypot(*e)
     p = p + shift
     ny, nx = valid.shape
+    for end in (p, p + e):
+        if not (0.0 <= end[0] <= nx and 0.0 <= end[1] <= ny):
+            return False  # on or beyond the grid's border, whose sides have their own boundary
     c0, c1 = max(int(np.floor(min(p[0], q[0]))), 0), min(int(np.ceil(max(p[0], q[0]))), nx)
     r0, r1 = max(int(np.floor(min(p[1], q[1]))), 0), min(int(np.ceil(max(p[1], q[1]))), ny)
     rows, cols = np.nonzero(valid[r0:r1, c0:c1])
@@ -178,16 +234,25 @@ def _chord_clear(p: np.ndarray, q: np.ndarray, valid: np.ndarray) -> bool:
     return not np.any(t_out > t_in)
 
 
+NUDGE_CELLS = 1e-3
+"""How far [cells] a seed is moved off a cell border, or inside a cell's edge."""
+
+
 def settle_seeds(x: np.ndarray, y: np.ndarray, valid: np.ndarray, dx: float, dy: float,
-                 reach: float) -> tuple[np.ndarray, np.ndarray]:
-    """Seed positions [m] moved off nodata and off cell borders: (x, y).
+                 reach: float, seg: np.ndarray | None) -> tuple[np.ndarray, ...]:
+    """Seed positions [m] moved off nodata outside the walls and off cell borders, and the
+    seeds that cannot be: (x, y, lost).
 
     * A seed in a nodata cell (a lattice node whose lattice cell holds water but whose own
-      cell has no data) moves to the centre of the nearest valid cell if that lies within
-      ``reach`` [m]; otherwise it stays (and the model removes it as outflow).
-    * A seed on the border of a valid cell next to nodata (of the 8 around it) moves 5 % of
-      a cell towards the cell's centre: simplified nodata walls run along such cells' edges
-      and through their corners, and a seed exactly on a wall belongs to neither side.
+      cell has no data) stays if the nodata border is walled (``seg`` holds the model's wall
+      segments, local metres) and no wall separates it from the centre of the nearest valid
+      cell: it lies in a sliver inside the walls. Otherwise it moves to the nearest point of
+      that valid cell (``NUDGE_CELLS`` inside its edges) if that lies within ``reach`` [m],
+      and is lost otherwise (the model removes it as outflow).
+    * A seed on the border of a valid cell next to nodata (of the 8 around it) moves
+      ``NUDGE_CELLS`` towards the cell's centre in each coordinate: simplified nodata walls
+      run along such cells' edges and through their corners, and a seed exactly on a wall
+      belongs to neither side.
     """
     from scipy import ndimage
 
@@ -200,18 +265,43 @@ def settle_seeds(x: np.ndarray, y: np.ndarray, valid: np.ndarray, dx: float, dy:
     on_grid = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
     bad = np.zeros_like(on_grid)
     bad[on_grid] = ~ok[row[on_grid], col[on_grid]]
+    lost = bad.copy()
     if bad.any() and ok.any():
-        _, (near_row, near_col) = ndimage.distance_transform_edt(~ok, return_indices=True)
-        r, c = near_row[row[bad], col[bad]], near_col[row[bad], col[bad]]
-        xc, yc = (c + 0.5) * dx, (r + 0.5) * dy
-        close = np.hypot(xc - x[bad], yc - y[bad]) <= reach
         idx = np.flatnonzero(bad)
-        x[idx[close]], y[idx[close]] = xc[close], yc[close]
+        _, (near_row, near_col) = ndimage.distance_transform_edt(~ok, return_indices=True)
+        r, c = near_row[row[idx], col[idx]], near_col[row[idx], col[idx]]
+        if seg is not None:
+            inside = ~_separated(x[idx], y[idx], (c + 0.5) * dx, (r + 0.5) * dy, seg)
+            lost[idx[inside]] = False
+            idx, r, c = idx[~inside], r[~inside], c[~inside]
+        xn = np.clip(x[idx], (c + NUDGE_CELLS) * dx, (c + 1 - NUDGE_CELLS) * dx)
+        yn = np.clip(y[idx], (r + NUDGE_CELLS) * dy, (r + 1 - NUDGE_CELLS) * dy)
+        close = np.hypot(xn - x[idx], yn - y[idx]) <= reach
+        x[idx[close]], y[idx[close]] = xn[close], yn[close]
         col[idx[close]], row[idx[close]] = c[close], r[close]
+        lost[idx[close]] = False
     shore = ndimage.binary_dilation(~ok, structure=np.ones((3, 3), dtype=bool))
     fx, fy = x / dx - col, y / dy - row
-    edge = on_grid & ((np.minimum(fx, 1.0 - fx) < 1e-6) | (np.minimum(fy, 1.0 - fy) < 1e-6))
+    edge = on_grid & ~bad & ((np.minimum(fx, 1 - fx) < 1e-6) | (np.minimum(fy, 1 - fy) < 1e-6))
     edge[edge] = shore[row[edge], col[edge]]
-    x[edge] += 0.1 * (0.5 - fx[edge]) * dx
-    y[edge] += 0.1 * (0.5 - fy[edge]) * dy
-    return x, y
+    x[edge] += NUDGE_CELLS * np.sign(0.5 - fx[edge]) * dx
+    y[edge] += NUDGE_CELLS * np.sign(0.5 - fy[edge]) * dy
+    return x, y, lost
+
+
+def _separated(x0, y0, x1, y1, seg: np.ndarray) -> np.ndarray:
+    """True where the segment (x0, y0)-(x1, y1) meets any wall segment (closed intervals,
+    as ``floodsph.sph.walls.crosses``)."""
+    out = np.zeros(np.shape(x0), dtype=bool)
+    if seg.shape[0] == 0:
+        return out
+    px, py = np.asarray(x0)[:, None], np.asarray(y0)[:, None]
+    ex, ey = np.asarray(x1)[:, None] - px, np.asarray(y1)[:, None] - py
+    fx, fy = (seg[:, 2] - seg[:, 0])[None, :], (seg[:, 3] - seg[:, 1])[None, :]
+    den = ex * fy - ey * fx
+    qx, qy = seg[None, :, 0] - px, seg[None, :, 1] - py
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (qx * fy - qy * fx) / den
+        u = (qx * ey - qy * ex) / den
+    hit = (den != 0.0) & (t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0)
+    return hit.any(axis=1)
