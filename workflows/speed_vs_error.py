@@ -237,11 +237,13 @@ def print_throughput(speed) -> None:
 
 def report(analytic, real, speed, picture, argv) -> str:
     """The markdown report: the command, the three tables and the picture."""
+    import numba
+
     command = " ".join(["python workflows/speed_vs_error.py", *(argv or sys.argv[1:])])
     lines = ["# floodsph: speed against error", "",
-             f"Made by `{command}` on {time.strftime('%Y-%m-%d')}, "
-             f"{os.cpu_count()} cores. Wall times are of this machine and this run: compare "
-             "rows, not runs.", ""]
+             f"Made by `{command}` on {time.strftime('%Y-%m-%d')}, {os.cpu_count()} cores, "
+             f"{numba.get_num_threads()} numba thread(s). Wall times are of this machine and "
+             "this run: compare rows, not runs.", ""]
     if analytic:
         lines += ["## Analytic cases (error against the exact solution)", "",
                   markdown([{"case": r.case, "refinement": r.refinement, "spacing m": r.spacing,
