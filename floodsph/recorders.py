@@ -46,7 +46,7 @@ class Recorders:
 
     def callbacks(self) -> list:
         """``(callable, schedule)`` pairs for the simulation."""
-        out = [(self.record_envelopes, TimeInterval(self.envelopes.interval_s))]
+        out = [(self.record_envelopes, TimeInterval(self.envelopes.interval_s, align=False))]
         if self.gauges is not None:
             out.append((self.record_gauges, TimeInterval(self.gauges.interval_s)))
         if self.snapshots is not None:

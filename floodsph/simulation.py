@@ -74,10 +74,12 @@ class Simulation:
         return self.model.t >= self.end_time - time_tolerance(self.end_time)
 
     def dt_max(self) -> float:
-        """The longest step that does not jump over the end time or a TimeInterval time [s]."""
+        """The longest step that does not jump over the end time or an aligned TimeInterval
+        time [s]."""
         t = self.model.t
         targets = [self.end_time]
-        targets += [s.next_time for _, s in self.callbacks if isinstance(s, TimeInterval)]
+        targets += [s.next_time for _, s in self.callbacks
+                    if isinstance(s, TimeInterval) and s.align]
         return min(target - t for target in targets if target > t + time_tolerance(target))
 
     def run(self) -> None:

@@ -8,6 +8,8 @@ exactly 100 m x 200 m x 2 m = 40 000 m3, all in the basin.
 
 from __future__ import annotations
 
+import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -90,3 +92,15 @@ def write_scenario(tmp_path, valley_dem):
 def scenario_file(write_scenario) -> Path:
     """The base scenario (valley DEM, reservoir at rest behind nothing, closed edges)."""
     return write_scenario()
+
+
+def load_workflow(name: str, path: Path):
+    """Import a workflow script (``workflows/...``) as module ``name``; its folder goes on
+    ``sys.path`` so that it finds the modules beside it."""
+    if str(path.parent) not in sys.path:
+        sys.path.insert(0, str(path.parent))
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module

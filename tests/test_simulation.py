@@ -53,6 +53,18 @@ def test_time_interval_lands_exactly_on_output_times():
     assert model.steps == 15
 
 
+def test_unaligned_time_interval_samples_without_shortening_steps():
+    """A sampling callback (the map envelopes) runs at the first step at or after each
+    mark; only the end time cuts a step: 0.96 s steps over 10 s take 11 steps, not 20."""
+    model = StubModel(dt=0.96)
+    log = []
+    Simulation(model, 10.0, [(recorder(log), TimeInterval(1.0, align=False))]).run()
+    assert model.steps == 11 and model.t == pytest.approx(10.0, abs=1e-12)
+    times = [t for _, t in log]
+    assert times == pytest.approx([0.0, *(0.96 * np.arange(2, 11)), 10.0], abs=1e-12)
+    assert all(a >= k for k, a in zip(range(1, 10), times[1:], strict=False))
+
+
 def test_end_time_not_a_multiple_of_the_interval():
     model = StubModel(dt=1.0)
     log = []

@@ -14,29 +14,19 @@ t in [300, 3600] s it is 20/3300 (t - 300)^2 / 2.
 from __future__ import annotations
 
 import csv
-import importlib.util
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from conftest import BASE_SCENARIO, X0, Y0, write_geotiff
+from conftest import BASE_SCENARIO, X0, Y0, load_workflow, write_geotiff
 
 REPO = Path(__file__).resolve().parents[1]
 
 
-def _load(name: str, path: Path):
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
-
-
-vgc = _load("workflow_versus_grid_code", REPO / "workflows" / "versus_grid_code.py")
-ea4 = _load("workflow_run_ea_test4", REPO / "workflows" / "ea_test4" / "run_ea_test4.py")
+vgc = load_workflow("workflow_versus_grid_code", REPO / "workflows" / "versus_grid_code.py")
+ea4 = load_workflow("workflow_run_ea_test4", REPO / "workflows" / "ea_test4" / "run_ea_test4.py")
 
 needs_anuga = pytest.mark.skipif(not vgc.anuga_available(), reason="ANUGA is not installed")
 EA4_DATA = ea4.data_folder()

@@ -15,33 +15,21 @@ reservoir at 100 m, the sea at 0 m and no arrival anywhere downstream.
 from __future__ import annotations
 
 import csv
-import importlib.util
 import json
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import BASE_SCENARIO, CELL, NX, NY, X0, Y0, write_geotiff
+from conftest import BASE_SCENARIO, CELL, NX, NY, X0, Y0, load_workflow, write_geotiff
 
 REPO = Path(__file__).resolve().parents[1]
 WORKFLOWS = REPO / "workflows"
 
 
-def _load(name: str, path: Path):
-    if str(path.parent) not in sys.path:
-        sys.path.insert(0, str(path.parent))
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-study = _load("compare_breach_scenarios", WORKFLOWS / "compare_breach_scenarios.py")
-mp_setup = _load("malpasset_setup", WORKFLOWS / "malpasset" / "malpasset_setup.py")
-mp_run = _load("run_malpasset", WORKFLOWS / "malpasset" / "run_malpasset.py")
+study = load_workflow("compare_breach_scenarios", WORKFLOWS / "compare_breach_scenarios.py")
+mp_setup = load_workflow("malpasset_setup", WORKFLOWS / "malpasset" / "malpasset_setup.py")
+mp_run = load_workflow("run_malpasset", WORKFLOWS / "malpasset" / "run_malpasset.py")
 
 DATA = mp_setup.data_folder()
 needs_malpasset = pytest.mark.skipif(

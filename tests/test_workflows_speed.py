@@ -9,28 +9,17 @@ markdown report and the picture.
 from __future__ import annotations
 
 import csv
-import importlib.util
-import sys
 from pathlib import Path
 
 import pytest
+from conftest import load_workflow
 
 REPO = Path(__file__).resolve().parents[1]
 WORKFLOWS = REPO / "workflows"
 
 
-def _load(name: str, path: Path):
-    if str(path.parent) not in sys.path:
-        sys.path.insert(0, str(path.parent))
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-speed = _load("speed_vs_error", WORKFLOWS / "speed_vs_error.py")
-bench = _load("refinement_benchmark", WORKFLOWS / "refinement_benchmark.py")
+speed = load_workflow("speed_vs_error", WORKFLOWS / "speed_vs_error.py")
+bench = load_workflow("refinement_benchmark", WORKFLOWS / "refinement_benchmark.py")
 
 
 def _rows(path: Path) -> list[dict]:

@@ -1,8 +1,9 @@
 """Running flood envelopes on the map grid, updated inside the run (not from snapshots).
 
 Maxima computed from saved snapshots miss the peaks between them (qgis-crayfish-plugin #202;
-GeoClaw fgmax exists for that reason), so the run loop calls :meth:`Envelopes.update` every
-``interval_s`` of simulated time (default 1 s). Each update rasterises the particles
+GeoClaw fgmax exists for that reason), so the run loop calls :meth:`Envelopes.update` at the
+first step at or after every ``interval_s`` of simulated time (default 1 s; the time step is
+not shortened to land on those marks). Each update rasterises the particles
 (:func:`floodsph.output.rasterise.rasterise`) and, cell by cell, with d the depth [m],
 s = |(u, v)| the speed [m/s], b the bed [m] and d_wet the wet threshold [m]:
 

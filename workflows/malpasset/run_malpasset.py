@@ -57,7 +57,7 @@ def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_T
     run_dir = where / "run"
     run_scenario(load_scenario(path), out_dir=run_dir, overwrite=overwrite, progress=progress,
                  max_steps=max_steps, threads=threads,
-                 callbacks=[(counter, TimeInterval(PARTICLE_COUNT_INTERVAL_S))])
+                 callbacks=[(counter, TimeInterval(PARTICLE_COUNT_INTERVAL_S, align=False))])
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     counter.write_csv(where / "particles.csv")
     points = setup.read_points(folder)
