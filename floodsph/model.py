@@ -31,6 +31,11 @@ from floodsph.sph import walls as wallmod
 from floodsph.sph.neighbours import CellGrid, NeighbourList
 from floodsph.terrain import Terrain
 
+MAX_SEARCH_GROWTH = 2.0
+"""Cap on the factor ``hgrow`` by which a particle's neighbour search is widened."""
+SETTLE_ROUNDS = 30
+"""Rounds of list building and density solve when the model is set up (h may grow 10-fold)."""
+
 
 @dataclass(frozen=True)
 class Numerics:
@@ -123,7 +128,8 @@ class FloodModel:
         self.volume_in = 0.0
         self.volume_out = 0.0
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
-                         "wall_reflections": 0, "density_unconverged": 0}
+                         "wall_reflections": 0, "density_unconverged": 0,
+                         "density_capped": 0}
         self.bed = np.empty((0, 7))
         self.blocked = np.empty(0, dtype=np.bool_)
         self._blocked_nl = None
@@ -131,7 +137,7 @@ class FloodModel:
             boundary.apply(self, 0.0)
         self._settle_seeds()
         self._remove_outside(nodata=closed_edges is False)
-        self._interactions()
+        self._interactions(settle=True)
         self.dt = self.stable_dt()
 
     def __repr__(self) -> str:
@@ -201,18 +207,20 @@ class FloodModel:
         return mask
 
     # -- stages --------------------------------------------------------------------------------
-    def _interactions(self) -> None:
+    def _interactions(self, settle: bool = False) -> None:
         """Neighbours, density and forces of the water, with the boundaries' ghosts present.
 
         The ghosts (inflow buffers, mirror images beyond open edges) are appended behind the
         water, given the boundary state after the density solve, and dropped after the forces.
+        ``settle`` is for the set-up (:meth:`_solve_density`).
         """
         p = self.particles
         water = p.mark()
+        self._nl_fresh = False
         for boundary in self.boundaries:
             boundary.add_ghosts(self)
         self._neighbours()
-        self._solve_density()
+        self._solve_density(settle)
         for boundary in self.boundaries:
             boundary.impose(self)
         self._forces()
@@ -253,15 +261,23 @@ class FloodModel:
             grid = CellGrid(p.x, p.y, 2.0 * float(np.mean(p.h)))
             p.permute(grid.order)
 
-    def _neighbours(self) -> None:
-        """Neighbour and near-wall lists, rebuilt only when the Verlet skin is used up."""
+    def _neighbours(self, force: bool = False) -> None:
+        """Neighbour and near-wall lists, rebuilt when the Verlet skin is used up (or ``force``).
+
+        The lists are built for h_i times the growth of h_i in the last density solve
+        (``hgrow``, at most ``MAX_SEARCH_GROWTH``): a particle at a thinning edge, whose h the
+        solve raises by 20-30 % a step, would otherwise exceed the skin in the solve and force
+        a second build and solve of every particle (one step in five on Malpasset).
+        """
         p = self.particles
         nl = getattr(self, "nl", None)
-        if nl is not None and nl.still_valid(p.x, p.y, p.h):
+        if not force and nl is not None and nl.still_valid(p.x, p.y, p.h):
             return
-        self.nl = NeighbourList(p.x, p.y, p.h, skin=self.numerics.neighbour_skin)
-        self.walls_near = self.wall_index.near_lists(p.x, p.y, p.h, self.nl.start, self.nl.nbr,
-                                                     self.nl.reach)
+        self._nl_fresh = True
+        h_search = p.h * np.clip(p.hgrow, 1.0, MAX_SEARCH_GROWTH)
+        self.nl = NeighbourList(p.x, p.y, h_search, skin=self.numerics.neighbour_skin)
+        self.walls_near = self.wall_index.near_lists(p.x, p.y, h_search, self.nl.start,
+                                                     self.nl.nbr, self.nl.reach)
 
     def _blocked_pairs(self) -> None:
         """Flag the listed pairs that a wall separates, at the current positions."""
@@ -272,18 +288,32 @@ class FloodModel:
         wallmod.blocked_pairs(p.x, p.y, self.nl.start, self.nl.nbr, *self.walls_near[:2],
                               self.seg, self.blocked)
 
-    def _solve_density(self) -> None:
+    def _solve_density(self, settle: bool = False) -> None:
+        """The depth-density solve.
+
+        In a time step no h grows beyond what the neighbour lists hold
+        (``solve_density(cap=True)``). A particle held back by lists built at this step
+        catches up over the next steps; if the lists are older, they are rebuilt and the solve
+        repeated once. When the model is set up (``settle``), h may move far from the seeding
+        guess, so the lists are rebuilt and the solve repeated until they hold (at most
+        ``SETTLE_ROUNDS``).
+        """
         num = self.numerics
         p = self.particles
-        for _ in range(3):
+        h_predicted = p.h.copy()
+        for _ in range(SETTLE_ROUNDS if settle else 2):
             self._blocked_pairs()
-            _, bad = density.solve_density(p, self.nl, self.blocked, self.walls_near, self.seg,
-                                           tol=num.density_tol, max_iter=num.density_max_iter,
-                                           h_ratio=num.h_ratio)
-            if self.nl.still_valid(p.x, p.y, p.h):
+            _, bad, capped = density.solve_density(
+                p, self.nl, self.blocked, self.walls_near, self.seg, tol=num.density_tol,
+                max_iter=num.density_max_iter, h_ratio=num.h_ratio, cap=not settle)
+            if settle and self.nl.still_valid(p.x, p.y, p.h):
                 break
-            self._neighbours()
+            if not settle and (capped == 0 or self._nl_fresh):
+                break
+            self._neighbours(force=True)
+        p.hgrow[:] = p.h / h_predicted
         self.counters["density_unconverged"] += bad
+        self.counters["density_capped"] += capped
 
     def _forces(self) -> None:
         p = self.particles

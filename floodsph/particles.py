@@ -27,6 +27,7 @@ FIELDS: dict[str, tuple[type, str]] = {
     "ax": (np.float64, "m s-2, acceleration east at the last force evaluation"),
     "ay": (np.float64, "m s-2, acceleration north at the last force evaluation"),
     "divv": (np.float64, "s-1, SPH velocity divergence at the last force evaluation"),
+    "hgrow": (np.float64, "h after / h before the last density solve (widens the next search)"),
     "level": (np.int64, "refinement level: number of splits in the particle's ancestry"),
     "born": (np.int64, "step at which the particle was created (split, merge or inflow)"),
     "pid": (np.int64, "unique particle id, never reused"),
@@ -77,7 +78,8 @@ class ParticleSet:
         """Append particles; ``x, y, m, rho, h`` are required, the rest default sensibly.
 
         ``u, v`` default to 0, ``h0``/``rho0`` to the given ``h``/``rho``, ``alpha`` to
-        2 rho (its lattice value), ``level`` to 0, ``born`` to 0. New ids are assigned.
+        2 rho (its lattice value), ``hgrow`` to 1, ``level`` to 0, ``born`` to 0. New ids are
+        assigned.
         Returns the slice of the new particles.
         """
         unknown = set(fields) - set(FIELDS)
@@ -93,6 +95,7 @@ class ParticleSet:
             "ax": 0.0,
             "ay": 0.0,
             "divv": 0.0,
+            "hgrow": 1.0,
             "level": 0,
             "born": 0,
         }

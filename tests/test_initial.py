@@ -7,7 +7,13 @@ from rasterio.transform import from_origin
 
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
-from floodsph.initial import depth_from_level, depth_from_raster, seed_particles
+from floodsph.initial import (
+    depth_from_level,
+    depth_from_raster,
+    lattice_depth,
+    lump_thin_cells,
+    seed_particles,
+)
 from floodsph.io.polygons import points_in_polygon
 from floodsph.terrain import Terrain
 
@@ -63,13 +69,18 @@ def test_seeded_volume_matches_grid_volume(ratio):
 
 
 def test_lattice_depth_at_dem_spacing_is_the_cell_depth():
+    """At the DEM spacing each lattice cell is a DEM cell; the seeds carry those depths after
+    the thin shore cells are lumped, and the volume."""
     ter = valley()
     d = depth_from_level(ter, LEVEL, RESERVOIR)
+    np.testing.assert_allclose(lattice_depth(ter, d, CELL)[2], d, atol=1e-12)
     p = seed_particles(ter, d, CELL, kappa=1.3)
     i = (p.y / CELL - 0.5).round().astype(int)
     j = (p.x / CELL - 0.5).round().astype(int)
-    np.testing.assert_allclose(p.rho / RHO_WATER, d[i, j])
-    assert p.n == np.count_nonzero(d > 1e-3)
+    lumped = lump_thin_cells(d)
+    np.testing.assert_allclose(p.rho / RHO_WATER, lumped[i, j])
+    assert p.n == np.count_nonzero(lumped > 1e-3)
+    assert p.volume() == pytest.approx(d.sum() * CELL**2, rel=1e-12)
 
 
 def test_degenerate_polygons_named():
@@ -141,3 +152,27 @@ def test_negative_depth_raster_refused(tmp_path):
     path = write_depth(tmp_path / "neg.tif", d, from_origin(ter.x0, ter.y0 + 400, 20, 20))
     with pytest.raises(InputError, match=r"initial_water\[2\]\.depth: .*neg.tif has negative"):
         depth_from_raster(ter, path, "initial_water[2].depth")
+
+
+def test_thin_shore_cells_give_their_water_to_the_deepest_neighbour():
+    """A steep shore (0.03 and 0.5 m beside 4-6 m) is lumped inwards, the volume kept; a
+    uniformly thin sheet and a gentle shore are left alone."""
+    from floodsph.initial import LUMP_RATIO
+
+    steep = np.array([[0.0, 0.0, 0.0, 0.0], [0.0, 0.03, 0.5, 5.0], [0.0, 0.02, 4.0, 6.0]])
+    lumped = lump_thin_cells(steep)
+    assert lumped.sum() == pytest.approx(steep.sum(), rel=1e-15)
+    np.testing.assert_allclose(lumped, [[0, 0, 0, 0], [0, 0, 0, 5.0], [0, 0, 4.05, 6.5]])
+    rng = np.random.default_rng(1)
+    bowl = np.maximum(10.0 - np.hypot(*np.meshgrid(np.arange(40.0), np.arange(40.0))) / 2.0,
+                      0.0) + rng.uniform(0.0, 0.2, (40, 40)) * (rng.random((40, 40)) < 0.1)
+    out = lump_thin_cells(bowl)
+    assert out.sum() == pytest.approx(bowl.sum(), rel=1e-12)
+    padded = np.pad(out, 1)
+    deepest = np.max([padded[1 + a:41 + a, 1 + b:41 + b] for a in (-1, 0, 1) for b in (-1, 0, 1)
+                      if a or b], axis=0)
+    assert np.all((out == 0.0) | (out * LUMP_RATIO >= deepest))
+    sheet = np.full((5, 5), 0.02)
+    np.testing.assert_array_equal(lump_thin_cells(sheet), sheet)
+    gentle = np.outer(np.ones(4), [0.5, 1.0, 1.5, 2.0])
+    np.testing.assert_array_equal(lump_thin_cells(gentle), gentle)

@@ -26,8 +26,9 @@ DEM = SAMPLE / "dem.tif"
 MAX_STEPS = 20
 
 
-def _reservoir_beds() -> tuple[np.ndarray, float]:
-    """Bed [m] of the reservoir cells (centre inside the polygon, below the level), level [m]."""
+def _reservoir() -> tuple[np.ndarray, np.ndarray, float]:
+    """The DEM's bed [m] (row 0 = north), its reservoir cells (centre inside the polygon,
+    below the level) and the level [m]."""
     import rasterio
 
     water = tomllib.loads(SCENARIO.read_text())["initial_water"][0]
@@ -40,7 +41,13 @@ def _reservoir_beds() -> tuple[np.ndarray, float]:
     y = np.asarray(y).reshape(bed.shape)
     # The polygon is an axis-aligned rectangle on cell edges: no centre lies on its boundary.
     inside = (x > min(xs)) & (x < max(xs)) & (y > min(ys)) & (y < max(ys))
-    return bed[inside & (bed < water["level_m"])], water["level_m"]
+    return bed, inside & (bed < water["level_m"]), water["level_m"]
+
+
+def _reservoir_beds() -> tuple[np.ndarray, float]:
+    """Bed [m] of the reservoir cells, level [m]."""
+    bed, wet, level = _reservoir()
+    return bed[wet], level
 
 
 @pytest.fixture(scope="module")
@@ -53,12 +60,18 @@ def sample_run(tmp_path_factory):
 
 
 def test_check_prints_one_particle_per_wet_cell():
-    beds, _ = _reservoir_beds()
+    """One particle per reservoir cell at the DEM spacing, less the thin shore cells lumped
+    into deeper neighbours (``floodsph.initial.lump_thin_cells``)."""
+    from floodsph.initial import lump_thin_cells
+
+    bed, wet, level = _reservoir()
+    depth = np.where(wet, level - bed, 0.0)[::-1]  # row 0 = south, as the terrain's grid
     result = CliRunner().invoke(cli, ["check", str(SCENARIO)])
     assert result.exit_code == 0, result.output
     match = re.search(r"^Particles:\s+(\d+)$", result.output, flags=re.MULTILINE)
     assert match is not None, result.output
-    assert int(match.group(1)) == beds.size == 2924
+    assert np.count_nonzero(wet) == 2924
+    assert int(match.group(1)) == np.count_nonzero(lump_thin_cells(depth) > 1e-3)
 
 
 def test_run_completes_the_asked_steps_with_closed_mass_budget(sample_run):

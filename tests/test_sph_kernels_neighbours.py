@@ -100,19 +100,18 @@ def test_verlet_list_stays_exact_while_particles_move_within_the_skin():
 
 
 def test_verlet_lists_kept_over_steps_give_the_flow_of_lists_rebuilt_every_step():
-    """Dam break against a building (walls, corners, near-wall lists): a wide skin keeps the
-    lists over several steps, and the flow is that of lists rebuilt at every step (to
-    round-off: the density is solved tightly, so the Newton path does not matter)."""
-    building = np.array([[220.0, 70.0], [280.0, 70.0], [280.0, 130.0], [220.0, 130.0],
-                         [220.0, 70.0]])
+    """Dam break across a closed box (walls, corners, near-wall lists) until the front meets
+    the far wall: a wide skin keeps the lists over several steps, and the flow is that of
+    lists rebuilt at (nearly) every step (to round-off: the density is solved tightly, so the
+    Newton path does not matter, and no h is held back by its lists)."""
 
     def depth(x, y):
         return np.where(x < 150.0, 4.0, 0.0)
 
     states, lists = [], []
     for skin in (0.1, 0.6):
-        model = model_on(lambda x, y: 0 * x, (0, 400), (0, 200), 10.0, depth, 10.0,
-                         walls=[building], neighbour_skin=skin, density_tol=1e-12)
+        model = model_on(lambda x, y: 0 * x, (0, 300), (0, 200), 10.0, depth, 10.0,
+                         neighbour_skin=skin, density_tol=1e-12)
         built, last = 0, None
         while model.t < 30.0:
             model.step()
@@ -122,10 +121,11 @@ def test_verlet_lists_kept_over_steps_give_the_flow_of_lists_rebuilt_every_step(
         order = np.argsort(p.pid)
         states.append(np.c_[p.x, p.y, p.u, p.v, p.rho][order])
         lists.append((built, model.steps))
+        assert model.counters["density_capped"] == 0
     (rebuilt, steps), (kept, steps_kept) = lists
-    assert rebuilt == steps and steps_kept == steps
+    assert rebuilt >= 0.9 * steps and steps_kept == steps
     assert kept < steps / 2
-    assert states[0][:, 0].max() > 280.0  # the front has passed the building
+    assert states[0][:, 0].max() > 285.0  # the front has reached the far wall
     np.testing.assert_allclose(states[1], states[0], rtol=1e-8, atol=1e-8)
 
 
@@ -166,3 +166,29 @@ def test_wall_lists_equal_a_brute_force_search():
         for q, j in enumerate(nbrs):
             crossed = any(walls.crosses(x[i], y[i], x[j], y[j], *seg[s]) for s in near)
             assert blocked[nl.start[i] + q] == crossed
+
+
+def test_bucket_clearance_bounds_the_wall_distance_and_keeps_lists_exact():
+    """Few walls in a large domain (one partly beyond its bounds): every point lies at least
+    its bucket's ``clear`` distance from every segment, most buckets are clear, and the near
+    lists that skip the walk on clear buckets still equal a brute-force search."""
+    from floodsph.sph import walls
+
+    seg = np.array([[100.0, 100.0, 300.0, 140.0], [300.0, 140.0, 320.0, 400.0],
+                    [-50.0, 700.0, 150.0, 760.0], [600.0, 20.0, 610.0, 25.0]])
+    index = walls.WallIndex(seg, (0.0, 0.0, 800.0, 800.0), bucket=20.0)
+    rng = np.random.default_rng(3)
+    n = 4000
+    x, y = rng.uniform(0.0, 800.0, n), rng.uniform(0.0, 800.0, n)
+    dist = np.array([[walls.segment_distance(x[i], y[i], *s) for s in seg] for i in range(n)])
+    b = (y // 20.0).astype(int) * index.nbx + (x // 20.0).astype(int)
+    assert np.all(dist.min(axis=1) >= index.clear[b])
+    assert np.mean(index.clear > 0.0) > 0.7
+    h = rng.uniform(5.0, 30.0, n)
+    nl = NeighbourList(x, y, h)
+    wstart, wseg, _, _ = index.near_lists(x, y, h, nl.start, nl.nbr, nl.reach)
+    for i in range(n):
+        nbrs = nl.nbr[nl.start[i]:nl.start[i + 1]]
+        radius = nl.reach * max(h[i], h[nbrs].max(initial=0.0))
+        np.testing.assert_array_equal(wseg[wstart[i]:wstart[i + 1]],
+                                      np.flatnonzero(dist[i] < radius))

@@ -208,7 +208,9 @@ def test_malpasset_sea_modes_differ_by_the_cells_below_sea_level(tmp_path):
     sea_cells = int(((bed < -1e-3) & ~bed.mask).sum())
     sea_volume = float((-bed[bed < 0]).sum()) * 20.0 * 20.0
     with_sea, sink = inputs["particles"][1], inputs["sink"][1]
-    assert with_sea.particles.n - sink.particles.n == sea_cells > 10_000
+    # one particle per sea cell, less the thin shore cells lumped into deeper ones (< 1 %)
+    added = with_sea.particles.n - sink.particles.n
+    assert sea_cells > 10_000 and 0.99 * sea_cells < added <= sea_cells
     assert with_sea.volume_initial_m3 - sink.volume_initial_m3 == pytest.approx(sea_volume,
                                                                                  rel=1e-5)
     # The sink polygon covers exactly the DEM cells below 0 m (cell centres inside).

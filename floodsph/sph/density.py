@@ -14,7 +14,11 @@ Units: rho [kg m-2] (= RHO_WATER * depth), h [m], m [kg], alpha [kg m-2].
 Iteration stops per particle when |R_i| / rho_i < tol. A particle whose update is not positive
 and finite falls back to the plain summation at its current h (SWE-SPHysics safeguard);
 h is kept within [h0 / h_ratio, h0 * h_ratio] so that an isolated particle, whose self
-contribution alone can never match its density, cannot grow without bound.
+contribution alone can never match its density, cannot grow without bound. In time steps
+h is also kept within what the Verlet neighbour list holds (its skin): a particle that would
+grow beyond it (a nearly isolated particle at a thin edge, whose solution can jump between
+two roots 20 % apart) takes the summation at that h and catches up over the next steps,
+instead of forcing a rebuild of every particle's list and a second solve.
 Mirror images across walls (``floodsph.sph.walls``) are part of the summation.
 """
 
@@ -104,18 +108,21 @@ def summation(i, hi, x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
 
 @njit(parallel=True, cache=True)
 def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
-          seg, tol, max_iter, h_ratio, iters):
+          seg, tol, max_iter, h_ratio, h_cap, iters):
     """Newton-Raphson solve (1)-(3) of every particle, in place (gather form).
 
     Only h_i changes the summation of particle i, so each particle iterates on its own to
     convergence. ``iters[i]`` receives the number of summations of particle i, negated when
     it did not converge in ``max_iter`` (it then takes the plain summation at its h).
     A particle already within ``tol`` keeps its (rho, h); alpha is that of the last summation.
+    A particle whose iterate would exceed ``h_cap[i]`` (the most its neighbour list holds)
+    stops at h_cap with the summation there, and ``iters[i]`` is set to 0 (capped).
     """
     for i in prange(x.shape[0]):
         it = 0
         done = False
-        while it < max_iter:
+        capped = False
+        while it < max_iter and not capped:
             s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
                              seg)
             alpha[i] = a
@@ -127,9 +134,10 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
             new = rho[i] * (1.0 - 2.0 * res / (2.0 * res + alpha[i]))
             if not (new > 0.0) or not math.isfinite(new) or alpha[i] <= 0.0:
                 new = s
-            h_new = h0[i] * math.sqrt(rho0[i] / new)
+            h_new = min(max(h0[i] * math.sqrt(rho0[i] / new), h0[i] / h_ratio), h0[i] * h_ratio)
+            capped = h_new > h_cap[i]
             rho[i] = new
-            h[i] = min(max(h_new, h0[i] / h_ratio), h0[i] * h_ratio)
+            h[i] = min(h_new, h_cap[i])
         if done:
             iters[i] = it
         else:
@@ -137,7 +145,7 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
                              seg)
             rho[i] = s
             alpha[i] = a
-            iters[i] = -it
+            iters[i] = 0 if capped else -it
 
 
 @njit(parallel=True, cache=True)
@@ -149,18 +157,22 @@ def predict(rho, h, divv, dt):
         h[i] *= 1.0 / math.sqrt(f)
 
 
-def solve_density(p, nl, blocked, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0):
-    """Solve (1)-(3) for all particles of ``p`` in place; return (iterations, unconverged).
+def solve_density(p, nl, blocked, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0, cap=False):
+    """Solve (1)-(3) for all particles of ``p`` in place.
 
     ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList;
     ``blocked`` its pairs separated by a wall (:func:`floodsph.sph.walls.blocked_pairs`);
     ``walls`` the near-wall lists (wstart, wseg, cstart, cpair) of
     :meth:`floodsph.sph.walls.WallIndex.near_lists`; ``seg`` the wall segments.
+    With ``cap``, no h grows beyond what ``nl`` holds (:meth:`NeighbourList.h_cap`), so the
+    lists stay valid through the solve.
     On return every particle has rho, h and alpha consistent with its neighbours to ``tol``,
-    except the returned number of unconverged ones, which take the plain summation.
-    ``iterations`` is the largest number of summations any particle needed.
+    except the unconverged and the capped ones, which take the plain summation at their h.
+    Returns (iterations, unconverged, capped); ``iterations`` is the largest number of
+    summations any particle needed.
     """
     iters = np.zeros(p.n, dtype=np.int64)
+    h_cap = nl.h_cap(p.x, p.y) if cap else np.full(p.n, np.inf)
     solve(p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked, *walls, seg,
-          tol, max_iter, h_ratio, iters)
-    return int(np.abs(iters).max(initial=0)), int((iters < 0).sum())
+          tol, max_iter, h_ratio, h_cap, iters)
+    return int(np.abs(iters).max(initial=0)), int((iters < 0).sum()), int((iters == 0).sum())

@@ -293,6 +293,14 @@ class NeighbourList:
         grow, move = _motion(x, y, h, self.x_built, self.y_built, self.h_built)
         return grow + move <= 1.0 + self.skin
 
+    def h_cap(self, x, y) -> np.ndarray:
+        """Largest smoothing lengths [m] the list still holds at the current positions:
+        h_b,i (1 + skin - D), so that G + D <= 1 + skin in :meth:`still_valid`."""
+        if x.shape[0] == 0:
+            return self.h_built.copy()
+        _, move = _motion(x, y, self.h_built, self.x_built, self.y_built, self.h_built)
+        return self.h_built * (1.0 + self.skin - move)
+
     def count(self) -> int:
         """Number of listed directed pairs (within the skin)."""
         return int(self.nbr.shape[0])

@@ -34,6 +34,7 @@ import math
 
 import numpy as np
 from numba import njit, prange
+from scipy import ndimage
 
 
 def segments_from_polylines(polylines) -> np.ndarray:
@@ -60,6 +61,12 @@ class WallIndex:
     radius visits the buckets its square overlaps and takes each segment in the first of them
     that the segment and the query square share (:func:`query_box`, :func:`first_visit`), so
     no segment is seen twice and the cost follows the walls near the point, not their total.
+
+    ``clear[b]`` is a lower bound [m] on the distance from any point of bucket b to any
+    segment: with e_b the Euclidean distance, in buckets, from b's centre to the centre of the
+    nearest bucket that lists a segment (a distance transform of the bucket grid), two points
+    in the two buckets are at least (e_b - sqrt 2) bucket apart. A particle whose radius is
+    below it has no near segment and skips the bucket walk (most particles, away from walls).
     """
 
     def __init__(self, seg: np.ndarray, bounds, bucket: float):
@@ -80,6 +87,8 @@ class WallIndex:
         self.start = np.zeros(len(lists) + 1, dtype=np.int64)
         np.cumsum(counts, out=self.start[1:])
         self.items = np.array([s for v in lists for s in v], dtype=np.int64)
+        self.clear = _clearance(counts.reshape(self.nby, self.nbx) > 0, self.bucket)
+        self.width = 16  # row width of the near-segment scan, widened when a row overflows
 
     @property
     def grid(self) -> tuple:
@@ -101,16 +110,34 @@ class WallIndex:
         if self.seg.shape[0] == 0 or n == 0:
             return (wstart, np.zeros(0, dtype=np.int64), cstart,
                     np.zeros((0, 2), dtype=np.int64))
-        args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items, *self.grid)
-        _near_scan(*args, wstart, np.zeros(0, dtype=np.int64), False)
-        np.cumsum(wstart, out=wstart)
+        args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items, self.clear,
+                *self.grid)
+        count = np.empty(n, dtype=np.int64)
+        while True:  # one scan into rows of ``width``; again, wider, if a row overflowed
+            rows = np.empty((n, self.width), dtype=np.int64)
+            _near_scan(*args, rows, count)
+            widest = int(count.max())
+            if widest <= self.width:
+                break
+            self.width = widest
+        np.cumsum(count, out=wstart[1:])
         wseg = np.empty(wstart[-1], dtype=np.int64)
-        _near_scan(*args, wstart, wseg, True)
+        _gather_rows(rows, wstart, wseg)
         _corner_scan(wstart, wseg, self.seg, cstart, np.zeros((0, 2), dtype=np.int64), False)
         np.cumsum(cstart, out=cstart)
         cpair = np.empty((cstart[-1], 2), dtype=np.int64)
         _corner_scan(wstart, wseg, self.seg, cstart, cpair, True)
         return wstart, wseg, cstart, cpair
+
+
+def _clearance(occupied: np.ndarray, bucket: float) -> np.ndarray:
+    """Per bucket (flat, row-major), a lower bound [m] on the distance to any listed segment:
+    bucket * (e - sqrt 2) with e the distance transform of the unoccupied buckets (inf when
+    no bucket lists a segment)."""
+    if not occupied.any():
+        return np.full(occupied.size, np.inf)
+    e = ndimage.distance_transform_edt(~occupied)
+    return (bucket * np.maximum(e - math.sqrt(2.0), 0.0)).ravel()
 
 
 @njit(inline="always", cache=True)
@@ -144,15 +171,22 @@ def first_visit(seg, s, bx, by, qbx0, qby0, xmin, ymin, bucket, nbx, nby):
 
 
 @njit(parallel=True, cache=True)
-def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, xmin, ymin, bucket, nbx, nby,
-               wstart, wseg, fill):
-    """Count (fill False: into wstart[i + 1]) or list (fill True, in index order) each
-    particle's segments within reach * max(h_i, max_j h_j)."""
+def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, xmin, ymin, bucket, nbx,
+               nby, rows, count):
+    """Count (into ``count[i]``) and list (into ``rows[i]``, in index order, as far as the row
+    is wide) each particle's segments within reach * max(h_i, max_j h_j); a particle inside
+    the bucket grid whose radius is below its bucket's ``clear`` distance has none."""
+    width = rows.shape[1]
     for i in prange(x.shape[0]):
+        count[i] = 0
         hr = h[i]
         for k in range(nstart[i], nstart[i + 1]):
             hr = max(hr, h[nbr[k]])
         radius = reach * hr
+        cx = (x[i] - xmin) / bucket
+        cy = (y[i] - ymin) / bucket
+        if 0.0 <= cx < nbx and 0.0 <= cy < nby and radius < clear[int(cy) * nbx + int(cx)]:
+            continue
         bx0, bx1, by0, by1 = query_box(x[i] - radius, y[i] - radius, x[i] + radius,
                                        y[i] + radius, xmin, ymin, bucket, nbx, nby)
         k = 0
@@ -165,13 +199,20 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, xmin, ymin, buck
                         continue
                     if segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2],
                                         seg[s, 3]) < radius:
-                        if fill:
-                            wseg[wstart[i] + k] = s
+                        if k < width:
+                            rows[i, k] = s
                         k += 1
-        if fill:
-            _sort_run(wseg, wstart[i], wstart[i] + k)
-        else:
-            wstart[i + 1] = k
+        count[i] = k
+        if k <= width:
+            _sort_run(rows[i], 0, k)
+
+
+@njit(parallel=True, cache=True)
+def _gather_rows(rows, wstart, wseg):
+    """Copy the first wstart[i + 1] - wstart[i] entries of each row into the CSR ``wseg``."""
+    for i in prange(rows.shape[0]):
+        for k in range(wstart[i + 1] - wstart[i]):
+            wseg[wstart[i] + k] = rows[i, k]
 
 
 @njit(inline="always", cache=True)
