@@ -66,10 +66,12 @@ def pair_coefficients(rho, alpha, h, coef):
     """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i).
 
     beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
-    1 / h_i [m^-1].
+    1 / h_i [m^-1]. A particle with no neighbour within its support (alpha_i = 0, possible
+    when its h is held back by its lists) takes beta_i = 1, the uncorrected force (alpha_i =
+    2 rho_i on a lattice).
     """
     for i in prange(rho.shape[0]):
-        coef[i, 0] = 2.0 * rho[i] / alpha[i]
+        coef[i, 0] = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
         coef[i, 1] = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
         coef[i, 2] = 1.0 / h[i]
 
@@ -152,7 +154,7 @@ def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, ws
                 c += 1
         ax[i] = fx
         ay[i] = fy
-        divv[i] = 2.0 * fd / alpha[i]
+        divv[i] = coef[i, 0] * fd / rho[i]  # (2 / alpha_i) fd, with beta's fallback
 
 
 @njit(inline="always", cache=True)
