@@ -265,9 +265,9 @@ class FloodModel:
         """Neighbour and near-wall lists, rebuilt when the Verlet skin is used up (or ``force``).
 
         The lists are built for h_i times the growth of h_i in the last density solve
-        (``hgrow``, at most ``MAX_SEARCH_GROWTH``): a particle at a thinning edge, whose h the
-        solve raises by 20-30 % a step, would otherwise exceed the skin in the solve and force
-        a second build and solve of every particle (one step in five on Malpasset).
+        (``hgrow``, at most ``MAX_SEARCH_GROWTH``), so that a particle whose h keeps growing
+        in the solves (a thinning edge) is not held back by its lists step after step
+        (:meth:`_solve_density`).
         """
         p = self.particles
         nl = getattr(self, "nl", None)

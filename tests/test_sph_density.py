@@ -39,6 +39,11 @@ def test_isolated_particle_has_bounded_h():
     model = FloodModel(terrain, p, Numerics(spacing=5.0, kappa=1.3, h_ratio=4.0))
     assert model.particles.h[0] == pytest.approx(4.0 * 6.5)
     assert np.isfinite(model.particles.rho[0]) and model.particles.rho[0] > 0
+    # no neighbour in its support (alpha = 0): the uncorrected force, no NaN in div v
+    assert model.particles.alpha[0] == 0.0
+    model.step()
+    p = model.particles
+    assert p.ax[0] == p.ay[0] == p.divv[0] == 0.0 and p.u[0] == p.v[0] == 0.0
 
 
 def test_capped_solve_keeps_the_lists_valid_and_catches_up_after_a_rebuild():

@@ -150,11 +150,9 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
 
 @njit(parallel=True, cache=True)
 def predict(rho, h, divv, dt):
-    """Continuity-based initial guess: rho (1 - dt div v), h (1 + dt div v / 2), the factor
-    1 - dt div v kept within [0.5, 2] (a guess only: the solve corrects it, within the reach
-    of the neighbour lists built for the guess)."""
+    """Continuity-based initial guess: rho (1 - dt div v), h (1 + dt div v / 2)."""
     for i in prange(rho.shape[0]):
-        f = min(max(1.0 - dt * divv[i], 0.5), 2.0)
+        f = max(1.0 - dt * divv[i], 0.5)
         rho[i] *= f
         h[i] *= 1.0 / math.sqrt(f)
 
