@@ -133,6 +133,7 @@ class FloodModel:
         self.bed = np.empty((0, 7))
         self.blocked = np.empty(0, dtype=np.bool_)
         self._blocked_nl = None
+        self._nl_fresh = False  # lists built in this step (by the refiner or the step itself)
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
         self._settle_seeds()
@@ -167,6 +168,7 @@ class FloodModel:
     def step(self, dt_max: float | None = None) -> float:
         """Advance one time step (at most ``dt_max``); return the step taken [s]."""
         p = self.particles
+        self._nl_fresh = False
         dt = self.dt if dt_max is None else min(self.dt, dt_max)
         half = 0.5 * dt
         p.u[:] += half * p.ax
@@ -216,7 +218,6 @@ class FloodModel:
         """
         p = self.particles
         water = p.mark()
-        self._nl_fresh = False
         for boundary in self.boundaries:
             boundary.add_ghosts(self)
         self._neighbours()

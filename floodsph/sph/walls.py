@@ -66,7 +66,7 @@ class WallIndex:
     segment: with e_b the Euclidean distance, in buckets, from b's centre to the centre of the
     nearest bucket that lists a segment (a distance transform of the bucket grid), two points
     in the two buckets are at least (e_b - sqrt 2) bucket apart. A particle whose radius is
-    below it has no near segment and skips the bucket walk (most particles, away from walls).
+    below it has no near segment and skips the bucket walk.
     """
 
     def __init__(self, seg: np.ndarray, bounds, bucket: float):
