@@ -169,6 +169,8 @@ class FloodModel:
         """Advance one time step (at most ``dt_max``); return the step taken [s]."""
         p = self.particles
         self._nl_fresh = False
+        if getattr(self, "nl", None) is None:  # particles were added or removed between steps
+            self._neighbours()
         dt = self.dt if dt_max is None else min(self.dt, dt_max)
         half = 0.5 * dt
         p.u[:] += half * p.ax
@@ -196,16 +198,16 @@ class FloodModel:
         self.dt = self.stable_dt()
         return dt
 
-    def near_wall(self) -> np.ndarray:
-        """True for particles with a wall segment within their kernel reach (needs ``nl``)."""
-        return np.diff(self.walls_near[0]) > 0
-
-    def protected(self) -> np.ndarray:
-        """True for particles near a wall or in an open boundary's zone (no merging there)."""
-        p = self.particles
-        mask = self.near_wall().copy()
+    def protected(self, x, y, h) -> np.ndarray:
+        """True for points (x, y) [m] with a wall segment within the kernel reach of h [m]
+        (with the neighbour lists' skin), or in an open boundary's zone: no merging there."""
+        n = x.shape[0]
+        reach = 2.0 * (1.0 + self.numerics.neighbour_skin)
+        wstart = self.wall_index.near_lists(x, y, h, np.zeros(n + 1, dtype=np.int64),
+                                            np.zeros(0, dtype=np.int64), reach)[0]
+        mask = np.diff(wstart) > 0
         for boundary in self.boundaries:
-            mask |= boundary.protected(p.x, p.y)
+            mask |= boundary.protected(x, y)
         return mask
 
     # -- stages --------------------------------------------------------------------------------
@@ -261,6 +263,7 @@ class FloodModel:
         if p.n:
             grid = CellGrid(p.x, p.y, 2.0 * float(np.mean(p.h)))
             p.permute(grid.order)
+            self.nl = None
 
     def _neighbours(self, force: bool = False) -> None:
         """Neighbour and near-wall lists, rebuilt when the Verlet skin is used up (or ``force``).

@@ -161,7 +161,8 @@ class Refiner:
 
         The index arrays refer to the current particle order and must be disjoint. The
         parents and the pairs are removed, the daughters and merged particles appended, and the
-        model's neighbour lists rebuilt; density and h are solved by the model's next step.
+        model's neighbour lists dropped; the step rebuilds them (with the boundaries' ghosts)
+        and solves density and h.
         """
         parents, a, b = (np.asarray(i, dtype=np.int64) for i in (parents, a, b))
         born = self._split(model, parents)
@@ -175,8 +176,7 @@ class Refiner:
         for fields in (born, merged):
             if fields is not None:
                 p.append(**fields)
-        model.nl = None  # the particles changed: rebuild the neighbour and near-wall lists
-        model._neighbours()
+        model.nl = None  # the particles changed: the neighbour and near-wall lists are stale
         return int(parents.size), int(a.size)
 
     # -- splitting ---------------------------------------------------------------------------
@@ -233,24 +233,31 @@ class Refiner:
     def merge_pairs(self, model) -> tuple[np.ndarray, np.ndarray]:
         """Index arrays (a, b) of the particle pairs to merge, a < b (module docstring).
 
-        Rebuilds the model's neighbour lists when there are candidates.
+        The nearest candidates are searched among the candidates alone, in lists of the pairs
+        with r_ab < max(h_a, h_b): that holds every pair that may merge (r_ab < min(h_a, h_b)),
+        and a candidate's nearest fellow, when it may merge with it, is within that range.
         """
         from floodsph.sph import refine
+        from floodsph.sph.neighbours import NeighbourList
 
         p = model.particles
         s = self.settings
-        cand = (p.m < self.area_min * p.rho) & (model.steps - p.born >= s.no_merge_steps)
         empty = np.zeros(0, dtype=np.int64)
-        if cand.sum() < 2:
+        idx = np.flatnonzero((p.m < self.area_min * p.rho)
+                             & (model.steps - p.born >= s.no_merge_steps))
+        if idx.size >= 2:
+            idx = idx[~model.protected(p.x[idx], p.y[idx], p.h[idx])]
+        if idx.size < 2:
             return empty, empty
-        model._neighbours()
-        cand &= ~model.protected()
-        nn = np.empty(p.n, dtype=np.int64)
-        refine.nearest_candidate(p.x, p.y, model.nl.start, model.nl.nbr, cand, nn)
-        a = np.flatnonzero(nn > np.arange(p.n))
+        x, y = p.x[idx], p.y[idx]
+        near = NeighbourList(x, y, 0.5 * p.h[idx], skin=0.0)
+        nn = np.empty(idx.size, dtype=np.int64)
+        refine.nearest_candidate(x, y, near.start, near.nbr, np.ones(idx.size, dtype=np.bool_),
+                                 nn)
+        a = np.flatnonzero(nn > np.arange(idx.size))
         b = nn[a]
         mutual = nn[b] == a
-        a, b = a[mutual], b[mutual]
+        a, b = idx[a[mutual]], idx[b[mutual]]
         d_a, d_b = p.rho[a] / RHO_WATER, p.rho[b] / RHO_WATER
         d_max = np.maximum(d_a, d_b)
         dv = np.hypot(p.u[a] - p.u[b], p.v[a] - p.v[b])

@@ -208,7 +208,7 @@ def test_no_merge_near_walls_across_jumps_or_of_newborns():
     refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0, depth_jump=0.2),
                       1.0)
     a, b = refiner.merge_pairs(model)
-    protected = model.protected()
+    protected = model.protected(p.x, p.y, p.h)
     assert not protected[a].any() and not protected[b].any()
     assert protected.any()
     d_a, d_b = p.rho[a], p.rho[b]
