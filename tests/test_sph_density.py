@@ -46,6 +46,26 @@ def test_isolated_particle_has_bounded_h():
     assert p.ax[0] == p.ay[0] == p.divv[0] == 0.0 and p.u[0] == p.v[0] == 0.0
 
 
+def test_isolated_particle_left_compressed_spreads_again():
+    """A lone particle thrown out of the water with h at its lower bound h0 / h_ratio and the
+    self-term density there (the state a plain summation leaves): its solve starts from the h
+    of its density, so h grows back (to the upper bound: a lone particle is a spreading film)
+    instead of keeping the tenfold-short h, and with it a tenfold-short time step."""
+    from floodsph.sph.kernels import SIGMA_2D
+
+    terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 1000), (0, 1000), 10.0)
+    p = particles_with_depth(np.array([500.0]), np.array([500.0]), np.array([1.0]), 5.0, 1.3)
+    model = FloodModel(terrain, p, Numerics(spacing=5.0, kappa=1.3, h_ratio=10.0))
+    p.h[0] = p.h0[0] / 10.0
+    p.rho[0] = p.m[0] * SIGMA_2D / p.h[0] ** 2
+    dt0 = model.stable_dt()
+    for _ in range(10):
+        model.step()
+    assert p.h[0] == pytest.approx(10.0 * p.h0[0])
+    assert p.rho[0] == pytest.approx(p.m[0] * SIGMA_2D / p.h[0] ** 2, rel=1e-12)
+    assert model.stable_dt() > 20.0 * dt0
+
+
 def test_capped_solve_keeps_the_lists_valid_and_catches_up_after_a_rebuild():
     """A guess far too dense (h 30 % short, as at a thin edge whose solve jumps): the capped
     solve stops that particle at the largest h its list holds, with the summation there, and

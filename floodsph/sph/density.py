@@ -117,11 +117,19 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
     A particle already within ``tol`` keeps its (rho, h); alpha is that of the last summation.
     A particle whose iterate would exceed ``h_cap[i]`` (the most its neighbour list holds)
     stops at h_cap with the summation there, and ``iters[i]`` is set to 0 (capped).
+    The iteration starts from h_i = h(rho_i) of (2) (within the bounds and the cap), not from
+    the h it comes with: a particle that last took a plain summation (capped, unconverged, or
+    at a bound of h) carries an h that does not satisfy (2), and an isolated one, whose
+    summation is its own self term, would otherwise pass the residual test at once and keep
+    that h for good (a lone particle thrown up a beach kept h0 / 10, and with it a time step
+    ten times too short).
     """
     for i in prange(x.shape[0]):
         it = 0
         done = False
-        capped = False
+        h_rho = min(max(h0[i] * math.sqrt(rho0[i] / rho[i]), h0[i] / h_ratio), h0[i] * h_ratio)
+        capped = h_rho > h_cap[i]
+        h[i] = min(h_rho, h_cap[i])
         while it < max_iter and not capped:
             s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
                              seg)
