@@ -133,7 +133,7 @@ class FloodModel:
         self.bed = np.empty((0, 7))
         self.blocked = np.empty(0, dtype=np.bool_)
         self._blocked_nl = None
-        self._nl_fresh = False  # lists built in this step (by the refiner or the step itself)
+        self._nl_fresh = False  # lists built in this step
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
         self._settle_seeds()

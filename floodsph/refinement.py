@@ -13,8 +13,9 @@ Criteria (thresholds are multiples of the initial particle area A0 = spacing^2):
 * split p when A_p > area_max A0, d_p >= d_min, level_p < max_level, and all seven daughters
   land on valid terrain on the parent's side of every wall, outside open-boundary zones;
 * merge a and b when A < area_min A0 for both, each is the other's nearest such candidate, they are
-  closer than min(h_a, h_b), neither is near a wall or an open boundary
-  (``FloodModel.protected``), neither was born (split, merge or inflow) in the last
+  closer than min(h_a, h_b), neither is near a wall (none within the kernel reach of the
+  larger of h and the merged particle's lattice h, kappa sqrt(2 A)) or in an open boundary's
+  zone (``FloodModel.protected``), neither was born (split, merge or inflow) in the last
   ``no_merge_steps`` steps, |d_a - d_b| <= depth_jump max(d_a, d_b) and
   |v_a - v_b| <= speed_jump sqrt(g max(d_a, d_b)) (no merging across fronts and bores).
 
@@ -245,8 +246,10 @@ class Refiner:
         empty = np.zeros(0, dtype=np.int64)
         idx = np.flatnonzero((p.m < self.area_min * p.rho)
                              & (model.steps - p.born >= s.no_merge_steps))
-        if idx.size >= 2:
-            idx = idx[~model.protected(p.x[idx], p.y[idx], p.h[idx])]
+        if idx.size >= 2:  # the wall test covers the support of the merged particle, too
+            reach_h = np.maximum(p.h[idx], model.numerics.kappa
+                                 * np.sqrt(2.0 * p.m[idx] / p.rho[idx]))
+            idx = idx[~model.protected(p.x[idx], p.y[idx], reach_h)]
         if idx.size < 2:
             return empty, empty
         x, y = p.x[idx], p.y[idx]

@@ -114,7 +114,8 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
     Only h_i changes the summation of particle i, so each particle iterates on its own to
     convergence. ``iters[i]`` receives the number of summations of particle i, negated when
     it did not converge in ``max_iter`` (it then takes the plain summation at its h).
-    A particle already within ``tol`` keeps its (rho, h); alpha is that of the last summation.
+    A particle already within ``tol`` at the start h (below) keeps its rho; alpha is that of the
+    last summation.
     A particle whose iterate would exceed ``h_cap[i]`` (the most its neighbour list holds)
     stops at h_cap with the summation there, and ``iters[i]`` is set to 0 (capped).
     The iteration starts from h_i = h(rho_i) of (2) (within the bounds and the cap), not from
