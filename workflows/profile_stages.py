@@ -1,0 +1,115 @@
+"""Where a run's time goes: wall time per stage of the time step, and list builds per step.
+
+Runs a scenario (the model of ``floodsph run``, without its outputs) for ``--steps`` steps or
+up to ``--end-time`` and times the stages of ``floodsph.model.FloodModel.step``: neighbour
+and near-wall lists (``_neighbours``), wall-blocked pairs, the density solve, the forces,
+the spatial re-sort, and refinement (the refiner's ``apply``). Times are exclusive.
+The rest of the step (drift, boundaries, friction, time step) is ``other``. Prints a markdown
+table and the neighbour-list builds per step. The first steps compile the numba kernels when
+they are not cached yet: ``--warmup`` steps (default 3) run before the clock starts.
+
+    python workflows/profile_stages.py SCENARIO.toml [--steps 500 | --end-time 600]
+        [--threads 2] [--warmup 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections import Counter
+from pathlib import Path
+
+from floodsph.output.tables import markdown
+
+STAGES = ("_neighbours", "_blocked_pairs", "_solve_density", "_forces", "_reorder")
+
+
+def timed(counter: Counter, stack: list, key: str, fn):
+    """``fn`` wrapped so that its exclusive wall time accumulates in ``counter[key]``: time
+    spent in another wrapped stage called from inside it (``stack``) counts there only."""
+    def wrapper(*args, **kwargs):
+        stack.append(key)
+        t0 = time.perf_counter()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            elapsed = time.perf_counter() - t0
+            stack.pop()
+            counter[key] += elapsed
+            if stack:
+                counter[stack[-1]] -= elapsed
+    return wrapper
+
+
+def profile(model, steps: int | None = None, end_time: float | None = None,
+            warmup: int = 3) -> tuple[list[dict], dict]:
+    """Step ``model`` and time its stages; returns (rows, totals).
+
+    ``rows`` has one dict per stage (``stage``, ``seconds``, ``percent``); ``totals`` the
+    wall time, steps, particle-steps and neighbour-list builds of the timed steps. Stage
+    methods are wrapped on this model instance only; a stage called from inside another
+    (lists built by the refiner) counts in both, so refinement includes its list builds.
+    """
+    from floodsph.sph import neighbours
+
+    for _ in range(warmup):
+        model.step()
+    times: Counter = Counter()
+    stack: list = []
+    for name in STAGES:
+        setattr(model, name, timed(times, stack, name.strip("_"), getattr(model, name)))
+    if model.refiner is not None:
+        model.refiner.apply = timed(times, stack, "refinement", model.refiner.apply)
+    builds = Counter()
+    build = neighbours.NeighbourList.__init__
+
+    def counting_build(self, *args, **kwargs):
+        builds["lists"] += 1
+        build(self, *args, **kwargs)
+
+    neighbours.NeighbourList.__init__ = counting_build
+    step0, particle_steps = model.steps, 0
+    t0 = time.perf_counter()
+    try:
+        while (steps is None or model.steps - step0 < steps) and (
+                end_time is None or model.t < end_time):
+            model.step()
+            particle_steps += model.particles.n
+    finally:
+        neighbours.NeighbourList.__init__ = build
+    wall = time.perf_counter() - t0
+    nsteps = model.steps - step0
+    times["other"] = wall - sum(times.values())
+    rows = [{"stage": k, "seconds": v, "percent": 100.0 * v / wall}
+            for k, v in times.most_common()]
+    totals = {"wall_s": wall, "steps": nsteps, "sim_time_s": model.t,
+              "particle_steps": particle_steps,
+              "list_builds_per_step": builds["lists"] / max(nsteps, 1)}
+    return rows, totals
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scenario", type=Path)
+    ap.add_argument("--steps", type=int, default=None, help="timed steps (default 500)")
+    ap.add_argument("--end-time", type=float, default=None, help="or run up to this time [s]")
+    ap.add_argument("--threads", type=int, default=0, help="numba threads (0 = all cores)")
+    ap.add_argument("--warmup", type=int, default=3, help="untimed steps first")
+    args = ap.parse_args(argv)
+    from floodsph.inputs import prepare_inputs
+    from floodsph.run import build_model, set_threads
+    from floodsph.scenario import load_scenario
+
+    set_threads(args.threads)
+    scenario = load_scenario(args.scenario)
+    model = build_model(scenario, prepare_inputs(scenario))
+    steps = args.steps if args.steps is not None or args.end_time is not None else 500
+    rows, totals = profile(model, steps=steps, end_time=args.end_time, warmup=args.warmup)
+    print(markdown(rows, spec=".3g"))
+    print()
+    print(markdown([totals], spec=".4g"))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
