@@ -33,3 +33,10 @@ def test_stage_times_are_exclusive_and_add_up_to_the_wall_time():
     assert sum(r["percent"] for r in rows) == pytest.approx(100.0, rel=1e-9)
     assert totals["steps"] == 40
     assert model.counters["splits"] > 0
+
+
+def test_a_bad_scenario_path_is_one_clear_error(tmp_path, capsys):
+    missing = tmp_path / "nope.toml"
+    assert prof.main([str(missing), "--steps", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("Error:") and "nope.toml" in err and "Traceback" not in err

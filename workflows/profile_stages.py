@@ -15,6 +15,7 @@ they are not cached yet: ``--warmup`` steps (default 3) run before the clock sta
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from collections import Counter
 from pathlib import Path
@@ -96,13 +97,18 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=0, help="numba threads (0 = all cores)")
     ap.add_argument("--warmup", type=int, default=3, help="untimed steps first")
     args = ap.parse_args(argv)
+    from floodsph.errors import InputError
     from floodsph.inputs import prepare_inputs
     from floodsph.run import build_model, set_threads
     from floodsph.scenario import load_scenario
 
     set_threads(args.threads)
-    scenario = load_scenario(args.scenario)
-    model = build_model(scenario, prepare_inputs(scenario))
+    try:
+        scenario = load_scenario(args.scenario)
+        model = build_model(scenario, prepare_inputs(scenario))
+    except InputError as exc:
+        print(f"Error: {exc}", file=sys.stderr)
+        return 2
     steps = args.steps if args.steps is not None or args.end_time is not None else 500
     rows, totals = profile(model, steps=steps, end_time=args.end_time, warmup=args.warmup)
     print(markdown(rows, spec=".3g"))

@@ -106,6 +106,12 @@ def summation(i, hi, x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
     return rsum, alpha
 
 
+@njit(inline="always", cache=True)
+def _h_of_rho(h0, rho0, rho, h_ratio):
+    """h = h0 (rho0 / rho)^(1/2) of (2) [m], kept within [h0 / h_ratio, h0 h_ratio]."""
+    return min(max(h0 * math.sqrt(rho0 / rho), h0 / h_ratio), h0 * h_ratio)
+
+
 @njit(parallel=True, cache=True)
 def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
           seg, tol, max_iter, h_ratio, h_cap, iters):
@@ -128,7 +134,7 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
     for i in prange(x.shape[0]):
         it = 0
         done = False
-        h_rho = min(max(h0[i] * math.sqrt(rho0[i] / rho[i]), h0[i] / h_ratio), h0[i] * h_ratio)
+        h_rho = _h_of_rho(h0[i], rho0[i], rho[i], h_ratio)
         capped = h_rho > h_cap[i]
         h[i] = min(h_rho, h_cap[i])
         while it < max_iter and not capped:
@@ -143,7 +149,7 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
             new = rho[i] * (1.0 - 2.0 * res / (2.0 * res + alpha[i]))
             if not (new > 0.0) or not math.isfinite(new) or alpha[i] <= 0.0:
                 new = s
-            h_new = min(max(h0[i] * math.sqrt(rho0[i] / new), h0[i] / h_ratio), h0[i] * h_ratio)
+            h_new = _h_of_rho(h0[i], rho0[i], new, h_ratio)
             capped = h_new > h_cap[i]
             rho[i] = new
             h[i] = min(h_new, h_cap[i])
