@@ -69,3 +69,22 @@ def dwdr_over_r_cubic(r, inv_r, inv_h):
     s = SIGMA_2D * inv_h * inv_h * inv_h
     t = max(2.0 - q, 0.0)
     return s * inv_h * (-3.0 + 2.25 * q) if q <= 1.0 else -s * 0.75 * t * t * inv_r
+
+
+@njit(inline="always", cache=True)
+def dwdr_over_r_floored(r, inv_r, inv_h):
+    """(dW/dr) / r [m^-4] of the cubic spline with |dW/dr| held at its peak below q = 2/3.
+
+        dW/dr = -sigma / h^3        0 <= q < 2/3     (sigma = 10 / (7 pi), h^3 as above)
+              = the cubic's         q >= 2/3
+
+    The cubic's gradient falls to zero as r -> 0, so a pair force built on it stops
+    repelling when two points come closer than 2h/3. Holding the gradient at its peak there
+    is the remedy of Thomas & Couchman, MNRAS 257 (1992) 11-31, for particle clumping. The
+    solver uses it for wall images only (``floodsph.sph.forces``), where it makes the wall's
+    push grow monotonically as a particle nears the wall.
+    """
+    q = r * inv_h
+    if q >= 2.0 / 3.0:
+        return dwdr_over_r_cubic(r, inv_r, inv_h)
+    return -SIGMA_2D * inv_h * inv_h * inv_h * inv_r
