@@ -13,7 +13,9 @@ the piecewise-constant depth grid over that cell, so the seeded volume equals th
 volume (to the shallow cells dropped below ``d_min``), at any ratio of particle spacing to
 DEM cell. Following Vacondio et al. (2013), m = rho_w d dx^2, rho = rho_w d and
 h = kappa dx; the solver then recomputes rho and h by summation. Cells much thinner than a
-neighbour (a steep shore) first give their water to it (:func:`lump_thin_cells`).
+neighbour (a steep shore) first give their water to it (:func:`lump_thin_cells`). Water is
+seeded on valid cells, and where the nodata border is walled also on the nodata slivers inside
+its simplified walls (:func:`wet_cells`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from rasterio.crs import CRS
 from rasterio.enums import Resampling
 from scipy import sparse
 
+from floodsph.boundaries.nodata_walls import walled_slivers
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
 from floodsph.io.polygons import check_polygon, points_in_polygon
@@ -37,8 +40,19 @@ LUMP_RATIO = 9.0
 at equal density) gives its water to that neighbour (:func:`lump_thin_cells`)."""
 
 
+def wet_cells(terrain: Terrain, walled: bool) -> np.ndarray:
+    """The cells initial water may fill: the valid ones, and where the nodata border is walled
+    (closed edges) the nodata slivers inside its simplified walls
+    (:func:`floodsph.boundaries.nodata_walls.walled_slivers`), which the water reaches in the
+    model as well; their bed is the nearest valid elevation (``floodsph.io.dem``)."""
+    if not walled:
+        return terrain.valid
+    return terrain.valid | walled_slivers(terrain.valid, terrain.dx, terrain.dy)
+
+
 def depth_from_level(
-    terrain: Terrain, level_m: float, polygon_local, name: str = "initial_water.polygon"
+    terrain: Terrain, level_m: float, polygon_local, name: str = "initial_water.polygon",
+    wet: np.ndarray | None = None,
 ) -> np.ndarray:
     """Water depth d = max(level - b, 0) [m] at the cell centres inside a polygon.
 
@@ -51,10 +65,12 @@ def depth_from_level(
         Polygon in LOCAL coordinates [m] (world minus ``(x0, y0)``).
     name : str
         Key path of the polygon for error messages.
+    wet : (ny, nx) bool array, optional
+        Cells that may hold water (default: the valid cells; :func:`wet_cells`).
 
     Returns
     -------
-    (ny, nx) float64 array, row 0 = south; 0 outside the polygon and on invalid cells.
+    (ny, nx) float64 array, row 0 = south; 0 outside the polygon and off ``wet``.
     """
     level = float(level_m)
     if not np.isfinite(level):
@@ -62,15 +78,17 @@ def depth_from_level(
     poly = check_polygon(polygon_local, name)
     xc, yc = terrain.cell_centres()
     X, Y = np.meshgrid(xc, yc)
-    inside = points_in_polygon(X, Y, poly) & terrain.valid
+    inside = points_in_polygon(X, Y, poly) & (terrain.valid if wet is None else wet)
     return np.where(inside, np.maximum(level - terrain.elevation, 0.0), 0.0)
 
 
-def depth_from_raster(terrain: Terrain, path, name: str = "initial_water.depth") -> np.ndarray:
+def depth_from_raster(terrain: Terrain, path, name: str = "initial_water.depth",
+                      wet: np.ndarray | None = None) -> np.ndarray:
     """Initial depth [m] from a raster on any grid, resampled (bilinear) onto the DEM grid.
 
-    Nodata and cells outside the raster become 0, as do invalid DEM cells. A negative depth
-    anywhere in the raster is an InputError naming ``name`` and the file.
+    Nodata and cells outside the raster become 0, as do cells off ``wet`` (default: the
+    invalid DEM cells; :func:`wet_cells`). A negative depth anywhere in the raster is an
+    InputError naming ``name`` and the file.
     """
     path = Path(path)
     grid = read_grid(path, what=f"{name} raster")
@@ -91,7 +109,7 @@ def depth_from_raster(terrain: Terrain, path, name: str = "initial_water.depth")
         label=path,
     )
     d = np.nan_to_num(north_up[::-1], nan=0.0)
-    return np.where(terrain.valid, np.maximum(d, 0.0), 0.0)
+    return np.where(terrain.valid if wet is None else wet, np.maximum(d, 0.0), 0.0)
 
 
 def _overlap_matrix(n_lattice: int, spacing: float, n_cells: int, cell: float):
@@ -183,6 +201,7 @@ def seed_particles(
     kappa: float,
     d_min: float = 1e-3,
     particles: ParticleSet | None = None,
+    wet: np.ndarray | None = None,
 ) -> ParticleSet:
     """Particles at the lattice nodes where the lattice-cell depth exceeds ``d_min``.
 
@@ -200,6 +219,8 @@ def seed_particles(
         Lattice cells with depth d <= d_min [m] get no particle.
     particles : ParticleSet, optional
         Set to append to; a new one is made by default.
+    wet : (ny, nx) bool array, optional
+        Cells that may hold water (default: the valid cells; :func:`wet_cells`).
 
     Returns
     -------
@@ -211,7 +232,8 @@ def seed_particles(
         raise ValueError(f"depth grid shape {depth_grid.shape} != terrain {terrain.shape}")
     if not (dx > 0 and kappa > 0):
         raise ValueError(f"particle spacing and kappa must be > 0, got {dx}, {kappa}")
-    d_cells = np.where(terrain.valid, np.nan_to_num(depth_grid, nan=0.0), 0.0)
+    d_cells = np.where(terrain.valid if wet is None else wet,
+                       np.nan_to_num(depth_grid, nan=0.0), 0.0)
     xs, ys, d = lattice_depth(terrain, d_cells, dx)
     d = lump_thin_cells(d)
     li, ki = np.nonzero(d > d_min)

