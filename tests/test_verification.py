@@ -15,7 +15,7 @@ from floodsph.refinement import Refinement
 def test_ritter_dam_break_coarse():
     r = cases.ritter(10.0)
     assert r.mass_error_rel < 1e-12
-    assert r.l1 < 0.04  # measured 3.7 % at 10 m
+    assert r.l1 < 0.025  # measured 2.1 % at 10 m (3.7 % before the own-image push was floored)
 
 
 def test_stoker_dam_break_coarse():
