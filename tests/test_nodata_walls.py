@@ -210,10 +210,10 @@ def test_oblique_nodata_walls_hold_the_water():
 
 
 @pytest.mark.xfail(strict=True, reason="issue 2: along oblique walls still water does not stay "
-                   "still: measured p95 0.57 m/s, max 3.8 m/s at 20 s (0.43 and 1.9 m/s at 100 s). "
-                   "Where the lattice meets an oblique wall the mirror images leave the depth off, "
-                   "and at the bends between chords images switch on and off as particles pass; "
-                   "a 10 % velocity damping per step does not make the motion decay")
+                   "still: measured p95 0.15 m/s, max 0.66 m/s at 20 s (0.22 and 0.91 m/s at "
+                   "100 s). Where the lattice meets an oblique wall the mirror images leave the "
+                   "depth off, and at the bends between chords images switch on and off as "
+                   "particles pass")
 def test_lake_at_rest_between_oblique_nodata_walls():
     """The method's lake-at-rest target along walls: max speed below 1 cm/s."""
     _, model, _ = lake_model()

@@ -81,8 +81,8 @@ def dwdr_over_r_floored(r, inv_r, inv_h):
     The cubic's gradient falls to zero as r -> 0, so a pair force built on it stops
     repelling when two points come closer than 2h/3. Holding the gradient at its peak there
     is the remedy of Thomas & Couchman, MNRAS 257 (1992) 11-31, for particle clumping. The
-    solver uses it for wall images only (``floodsph.sph.forces``), where it makes the wall's
-    push grow monotonically as a particle nears the wall.
+    solver uses it only between a particle and its own wall images (``floodsph.sph.forces``),
+    where it makes the wall's push grow monotonically as the particle nears the wall.
     """
     q = r * inv_h
     if q >= 2.0 / 3.0:

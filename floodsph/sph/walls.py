@@ -4,17 +4,22 @@ A wall is a polyline (a closed one is a solid footprint); the DEM border is four
 the edges are closed. Three mechanisms keep water on its side:
 
 1. **Mirror particles.** For a particle i near a wall segment, every neighbour j on i's side
-   (i itself included) whose foot point falls on the segment contributes a mirror image
-   x_j' = 2 f_j - x_j (f_j its foot on the segment's line), with the same mass, density,
-   alpha and h and the mirrored velocity v_j' = v_j - 2 (v_j . n) n (free slip). On a straight
-   wall this completes the kernel exactly, so the depth and the pressure of still water along
-   a wall are those of the interior (zero-order consistency, the property the modified virtual
-   boundary particles of Vacondio, Rogers & Stansby, IJNMF 69 (2012) 226-253 approximate).
-   An image counts only if the line from i to it passes through the segment that made it,
-   so that behind a convex corner (a building's) each point is imaged once, not by both faces.
-   In a right-angled corner where two near segments meet, j's foot on both gives a third
-   image, the reflection of j's first image about the second wall (the point reflection
-   through the corner), which completes the kernel there too.
+   (i itself included) contributes a mirror image x_j' = 2 f_j - x_j (f_j its foot on the
+   segment's line), with the same mass, density, alpha and h and the mirrored velocity
+   v_j' = v_j - 2 (v_j . n) n (free slip), if the line from i to the image passes through the
+   segment: the images fill the part of i's support hidden from i behind the wall. On a
+   straight wall this completes the kernel exactly, so the depth and the pressure of still
+   water along a wall are those of the interior (zero-order consistency, the property the
+   modified virtual boundary particles of Vacondio, Rogers & Stansby, IJNMF 69 (2012) 226-253
+   approximate). Behind a convex corner (a building's) each hidden point is imaged once, by
+   the face the line passes through. j's foot need not fall on the segment: where a wall
+   bends, a point hidden behind one segment may be the image of a particle in front of the
+   next (an earlier version required the foot on the segment, and lost those images near every
+   vertex of a polyline). A point seen exactly through a vertex that two segments share is
+   imaged through both; on a lattice aligned with a building this makes the particle on the
+   corner's diagonal 5 % too deep. In a right-angled corner where two near segments meet,
+   j's foot on both gives a third image, the reflection of j's first image about the second
+   wall (the point reflection through the corner), which completes the kernel there too.
 2. **Pair blocking.** Particles on opposite sides of a wall do not interact.
 3. **Crossing guard.** A drift step that would cross a wall is reflected about it (position and
    normal velocity), so no particle ever crosses, whatever the time step (:func:`drift`).
@@ -335,10 +340,11 @@ def mirror(px, py, x1, y1, x2, y2):
 def wall_image(xi, yi, px, py, seg, s):
     """Mirror image of p about segment s as seen from particle i: (x', y', ok).
 
-    ok requires p's foot on the segment and the line from i to the image to pass through it.
+    ok: the line from i to the image passes through the segment (the image lies in the part
+    of i's support hidden behind s); p's foot may fall beyond the segment's ends.
     """
-    xm, ym, on, _, _ = mirror(px, py, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-    ok = on and crosses(xi, yi, xm, ym, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+    xm, ym, _, _, _ = mirror(px, py, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+    ok = crosses(xi, yi, xm, ym, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
     return xm, ym, ok
 
 
