@@ -61,18 +61,14 @@ def test_still_water_along_walls_and_in_corners_of_a_closed_box_stays_still():
     assert np.abs(model.depth() - 3.0).max() < 0.01
 
 
-@pytest.mark.parametrize("vertex_x", [
-    103.0,
-    pytest.param(100.0, marks=pytest.mark.xfail(
-        strict=True, reason="a vertex midway between two lattice columns: the line from each "
-        "of the two particles beside it to the other's image passes exactly through the "
-        "vertex, so both segments image it (4.9 % too deep there)")),
-])
+@pytest.mark.parametrize("vertex_x", [103.0, 100.0])
 def test_a_wall_split_in_two_collinear_segments_completes_the_kernel_as_one(vertex_x):
     """Still water north of a wall along y = 50 m: the depth is the same, exact to round-off,
     whether the wall is one segment or two meeting at x = ``vertex_x`` (images are taken
     through whichever segment hides them; requiring the image's foot on the segment lost some
-    near the vertex: 3 m water read 2.80 m there)."""
+    near the vertex: 3 m water read 2.80 m there). At x = 100 m, midway between two lattice
+    columns, the sight line from each particle beside the vertex to the other's image passes
+    exactly through it; imaged through both segments, they read 3.15 m."""
     depth = lambda x, y: np.where(y > 50.0, 3.0, 0.0)  # noqa: E731
     one = model_on(lambda x, y: 0 * x, (0, 200), (0, 100), 10.0, depth, 10.0,
                    walls=[np.array([[-10.0, 50.0], [210.0, 50.0]])])
@@ -117,10 +113,11 @@ def test_a_dam_break_between_side_walls_stays_uniform_across_the_channel():
         assert np.all(np.abs(d[[0, 2]] / d[1] - 1.0) < 0.03)
 
 
-@pytest.mark.xfail(strict=True, reason="convex building corners: the particle on each corner's "
-                   "diagonal is 4.9 % too deep at t = 0 (imaged through both faces); 0.99 m/s "
-                   "spurious speed after 100 s, p95 0.064 m/s (issue 2)")
 def test_still_water_around_a_building_stays_still():
+    """A closed footprint with four convex corners, aligned with the lattice. Until sight lines
+    through a vertex were settled one way (``floodsph.sph.walls.hides``), the particle on each
+    corner's diagonal was imaged through both faces, 4.9 % too deep, and the water moved at
+    up to 1-2 m/s within 100 s."""
     building = np.array([[300.0, 200.0], [500.0, 200.0], [500.0, 400.0], [300.0, 400.0],
                          [300.0, 200.0]])
 
@@ -130,9 +127,11 @@ def test_still_water_around_a_building_stays_still():
 
     model = model_on(lambda x, y: 0 * x, (0, 800), (0, 600), 10.0, depth, 10.0,
                      walls=[building])
+    assert np.abs(model.depth() - 3.0).max() < 1e-9
     run_until(model, 100.0)
     p = model.particles
     assert np.hypot(p.u, p.v).max() < 1e-3
+    assert np.abs(model.depth() - 3.0).max() < 0.01
 
 
 def test_lake_at_rest_over_a_bump_stays_at_rest():

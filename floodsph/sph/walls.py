@@ -15,11 +15,11 @@ the edges are closed. Three mechanisms keep water on its side:
    the face the line passes through. j's foot need not fall on the segment: where a wall
    bends, a point hidden behind one segment may be the image of a particle in front of the
    next (an earlier version required the foot on the segment, and lost those images near every
-   vertex of a polyline). A point seen exactly through a vertex that two segments share is
-   imaged through both; on a lattice aligned with a building this makes the particle on the
-   corner's diagonal 5 % too deep. In a right-angled corner where two near segments meet,
-   j's foot on both gives a third image, the reflection of j's first image about the second
-   wall (the point reflection through the corner), which completes the kernel there too.
+   vertex of a polyline). A sight line exactly through a vertex is settled by a fixed shift of
+   1e-7 m (:func:`hides`), so that point is imaged once. In a right-angled corner where two
+   near segments meet, j's foot on both gives a third image, the reflection of j's first image
+   about the second wall (the point reflection through the corner), which completes the kernel
+   there too.
 2. **Pair blocking.** Particles on opposite sides of a wall do not interact.
 3. **Crossing guard.** A drift step that would cross a wall is reflected about it (position and
    normal velocity), so no particle ever crosses, whatever the time step (:func:`drift`).
@@ -297,12 +297,30 @@ def crosses(ax, ay, bx, by, x1, y1, x2, y2):
     return 0.0 <= t <= 1.0 and 0.0 <= s <= 1.0
 
 
+TIE_SHIFT = (0.6e-7, 0.8e-7)
+"""Offset [m] of the sight lines of :func:`hides` (a fixed direction, 1e-7 m long)."""
+
+
+@njit(inline="always", cache=True)
+def hides(ax, ay, bx, by, seg, s):
+    """True if segment s lies across the sight line from a to b.
+
+    The test is :func:`crosses` on the line shifted by ``TIE_SHIFT``: a line through an end
+    point of s, such as a vertex two segments share (common where vertices lie on DEM cell
+    corners and particles on cell centres), then passes on one definite side of it. Pair
+    blocking and the mirror images use this one test, so a hidden point is imaged through one
+    segment only, and a neighbour is either seen or replaced by its image, never both.
+    """
+    dx, dy = TIE_SHIFT
+    return crosses(ax + dx, ay + dy, bx + dx, by + dy, seg[s, 0], seg[s, 1], seg[s, 2],
+                   seg[s, 3])
+
+
 @njit(inline="always", cache=True)
 def blocked(xi, yi, xj, yj, wstart, wseg, seg, i):
-    """True if a wall near particle i separates it from the point (xj, yj)."""
+    """True if a wall near particle i separates it from the point (xj, yj) (:func:`hides`)."""
     for k in range(wstart[i], wstart[i + 1]):
-        s = wseg[k]
-        if crosses(xi, yi, xj, yj, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]):
+        if hides(xi, yi, xj, yj, seg, wseg[k]):
             return True
     return False
 
@@ -340,11 +358,11 @@ def mirror(px, py, x1, y1, x2, y2):
 def wall_image(xi, yi, px, py, seg, s):
     """Mirror image of p about segment s as seen from particle i: (x', y', ok).
 
-    ok: the line from i to the image passes through the segment (the image lies in the part
-    of i's support hidden behind s); p's foot may fall beyond the segment's ends.
+    ok: s hides the image from i (:func:`hides`: the line from i to it passes through the
+    segment); p's foot may fall beyond the segment's ends.
     """
     xm, ym, _, _, _ = mirror(px, py, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-    ok = crosses(xi, yi, xm, ym, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+    ok = hides(xi, yi, xm, ym, seg, s)
     return xm, ym, ok
 
 
