@@ -55,6 +55,9 @@ from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.errors import InputError
 
 MODES = ("split+coalesce", "split", "none")
+HEXAGON_MARGIN = 1.01
+"""Radius, relative to a parent's hexagon, within which wall segments are tested against the
+lines to its daughters (a segment across such a line is closer than the radius itself)."""
 RELAX_RATE = 0.2
 """Fraction of the excess ln(h^2 rho / (SMOOTHING_EXCESS kappa^2 m)) removed per step."""
 SMOOTHING_EXCESS = 3.0
@@ -200,9 +203,13 @@ class Refiner:
         ok = ok.reshape(-1, refine.DAUGHTERS).all(axis=1)
         wi = model.wall_index
         if wi.seg.shape[0]:
-            clear = np.empty(idx.size, dtype=np.bool_)
-            refine.daughters_clear(p.x[idx], p.y[idx], x, y, wi.seg, wi.start, wi.items,
-                                   *wi.grid, clear)
+            n = idx.size
+            d = refine.DAUGHTERS
+            radius = np.hypot(x[1::d] - p.x[idx], y[1::d] - p.y[idx])
+            wstart, wseg = wi.near_lists(p.x[idx], p.y[idx], radius, np.zeros(n + 1, np.int64),
+                                         np.zeros(0, np.int64), HEXAGON_MARGIN)[:2]
+            clear = np.empty(n, dtype=np.bool_)
+            refine.daughters_clear(p.x[idx], p.y[idx], x, y, wstart, wseg, wi.seg, clear)
             ok &= clear
         return idx[ok]
 

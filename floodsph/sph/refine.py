@@ -45,7 +45,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import SIGMA_2D, w_cubic
-from floodsph.sph.walls import crosses, first_visit, query_box
+from floodsph.sph.walls import crosses
 
 VERTEX_FRACTION = 0.136882287617319
 """Mass of each of the six hexagon daughters over the parent's mass [V12-split]."""
@@ -92,29 +92,22 @@ def daughters(xp, yp, up, vp, mp, hp, eps, still, x, y, m):
 
 
 @njit(parallel=True, cache=True)
-def daughters_clear(xp, yp, x, y, seg, bstart, items, xmin, ymin, bucket, nbx, nby, out):
+def daughters_clear(xp, yp, x, y, wstart, wseg, seg, out):
     """out[k] = True when no wall segment separates parent k from any of its 7 daughters.
 
-    The segments come from the buckets of ``floodsph.sph.walls.WallIndex`` (its ``start``,
-    ``items`` and ``grid``) that the square around the hexagon overlaps.
+    ``(wstart, wseg)`` lists the segments near each parent, within its hexagon's radius
+    (``floodsph.sph.walls.WallIndex.near_lists``); a segment that crosses the line from the
+    parent to a daughter is among them.
     """
     for k in prange(xp.shape[0]):
         base = DAUGHTERS * k
-        radius = math.hypot(x[base + 1] - xp[k], y[base + 1] - yp[k])
-        bx0, bx1, by0, by1 = query_box(xp[k] - radius, yp[k] - radius, xp[k] + radius,
-                                       yp[k] + radius, xmin, ymin, bucket, nbx, nby)
         ok = True
-        for by in range(by0, by1 + 1):
-            for bx in range(bx0, bx1 + 1):
-                b = by * nbx + bx
-                for q in range(bstart[b], bstart[b + 1]):
-                    s = items[q]
-                    if not first_visit(seg, s, bx, by, bx0, by0, xmin, ymin, bucket, nbx, nby):
-                        continue
-                    for j in range(1, DAUGHTERS):
-                        if crosses(xp[k], yp[k], x[base + j], y[base + j], seg[s, 0],
-                                   seg[s, 1], seg[s, 2], seg[s, 3]):
-                            ok = False
+        for w in range(wstart[k], wstart[k + 1]):
+            s = wseg[w]
+            for j in range(1, DAUGHTERS):
+                if crosses(xp[k], yp[k], x[base + j], y[base + j], seg[s, 0], seg[s, 1],
+                           seg[s, 2], seg[s, 3]):
+                    ok = False
         out[k] = ok
 
 
