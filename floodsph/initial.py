@@ -86,8 +86,8 @@ def depth_from_raster(terrain: Terrain, path, name: str = "initial_water.depth",
                       wet: np.ndarray | None = None) -> np.ndarray:
     """Initial depth [m] from a raster on any grid, resampled (bilinear) onto the DEM grid.
 
-    Nodata and cells outside the raster become 0, as do cells off ``wet`` (default: the
-    invalid DEM cells; :func:`wet_cells`). A negative depth anywhere in the raster is an
+    Nodata and cells outside the raster become 0, as do cells outside ``wet`` (default: the
+    valid DEM cells; :func:`wet_cells`). A negative depth anywhere in the raster is an
     InputError naming ``name`` and the file.
     """
     path = Path(path)

@@ -210,7 +210,7 @@ def test_oblique_nodata_walls_hold_the_water():
 
 
 @pytest.mark.xfail(strict=True, reason="issue 2: along oblique walls still water does not stay "
-                   "still: measured p95 0.15 m/s, max 0.66 m/s at 20 s (0.22 and 0.91 m/s at "
+                   "still: measured p95 0.14 m/s, max 0.89 m/s at 20 s (0.22 and 1.2 m/s at "
                    "100 s). Where the lattice meets an oblique wall the mirror images leave the "
                    "depth off, and at the bends between chords images switch on and off as "
                    "particles pass")

@@ -47,8 +47,9 @@ def test_thacker_at_100m_meets_targets():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="uniform resolution: L1 3.7 / 2.2 % at 10 / 5 m and "
-                   "the front (0.1 m) 210 / 118 m behind; the thin front needs splitting")
+@pytest.mark.xfail(strict=True, reason="uniform resolution: L1 2.1 / 1.1 / 0.8 % at 10 / 5 / "
+                   "2.5 m meets 1.5 % at 5 m, but the order is 0.67 and the front (0.1 m) is "
+                   "197 / 43 / 32 m behind; the thin front needs splitting")
 def test_ritter_convergence_meets_targets():
     results = [cases.ritter(dx) for dx in (10.0, 5.0, 2.5)]
     errors = [r.l1 for r in results]
@@ -59,9 +60,9 @@ def test_ritter_convergence_meets_targets():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="split+coalesce: L1 1.02 / 0.89 / 0.63 % at 10 / 5 / "
-                   "2.5 m (order 0.35: split noise where the particles first split, 900-1100 m, "
-                   "dominates); front 18 / 12 / 9 m behind (two spacings only at 10 m)")
+@pytest.mark.xfail(strict=True, reason="split+coalesce: L1 0.93 / 0.83 / 0.63 % at 10 / 5 / "
+                   "2.5 m (order 0.28: split noise where the particles first split, 900-1100 m, "
+                   "dominates); front 22 / 11 / 10 m behind (two spacings only at 10 m)")
 def test_refined_ritter_convergence_meets_targets():
     results = [cases.ritter(dx, refinement=Refinement()) for dx in (10.0, 5.0, 2.5)]
     errors = [r.l1 for r in results]
@@ -73,8 +74,8 @@ def test_refined_ritter_convergence_meets_targets():
 @pytest.mark.slow
 def test_refined_ritter_at_5m_beats_the_uniform_run():
     """Splitting resolves the thin front: at 5 m the L1 error meets the 1.5 % target
-    (measured 0.89 %, uniform 2.2 %) and the front is within 3 spacings (12 m behind,
-    uniform 118 m)."""
+    (measured 0.83 %, uniform 1.1 %) and the front is within 3 spacings (11 m behind,
+    uniform 43 m)."""
     r = cases.ritter(5.0, refinement=Refinement())
     assert r.mass_error_rel < 1e-12 and r.splits > 0 and r.merges > 0
     assert r.l1 <= 0.015
