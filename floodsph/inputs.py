@@ -50,7 +50,6 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     """Load and check everything a run needs; raises ``InputError`` on bad input."""
     from floodsph.initial import seed_particles, wet_cells
     from floodsph.io.dem import load_terrain
-    from floodsph.scenario import Edges
 
     tc = scenario.terrain
     terrain = load_terrain(
@@ -66,7 +65,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     for i, inflow in enumerate(scenario.inflows):
         for point in inflow.line:
             _check_on_dem(terrain, point, f"{source}: inflows[{i}].line")
-    wet = wet_cells(terrain, walled=tc.edges is Edges.CLOSED or bool(tc.closed_sides))
+    wet = wet_cells(terrain, walled=tc.nodata_walled)
     depth = initial_depth(scenario, terrain, wet)
     spacing = scenario.numerics.particle_spacing_m or float(min(terrain.dx, terrain.dy))
     particles = seed_particles(terrain, depth, spacing, scenario.numerics.kappa, wet=wet)

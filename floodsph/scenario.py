@@ -80,6 +80,12 @@ class TerrainConfig:
     edges: Edges = Edges.OPEN
     closed_sides: tuple[str, ...] = ()
 
+    @property
+    def nodata_walled(self) -> bool:
+        """True when the DEM's nodata border is a wall: edges closed, or any side kept closed
+        (``floodsph.model.FloodModel`` walls nodata unless every edge is open)."""
+        return self.edges is Edges.CLOSED or bool(self.closed_sides)
+
 
 @dataclass(frozen=True)
 class InitialWater:

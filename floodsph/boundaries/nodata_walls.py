@@ -249,13 +249,13 @@ def walled_slivers(valid: np.ndarray, dx: float, dy: float,
     """
     from scipy import ndimage
 
+    from floodsph.sph.walls import segments_from_polylines
+
     ok = np.asarray(valid, dtype=bool)
     out = np.zeros_like(ok)
     if ok.all() or not ok.any():
         return out
-    seg_list = [np.column_stack([line[:-1], line[1:]])
-                for line in nodata_polylines(ok, dx, dy, tolerance=tolerance)]
-    seg = np.concatenate(seg_list) if seg_list else np.empty((0, 4))
+    seg = segments_from_polylines(nodata_polylines(ok, dx, dy, tolerance=tolerance))
     _, (near_row, near_col) = ndimage.distance_transform_edt(~ok, return_indices=True)
     rows, cols = np.nonzero(ndimage.binary_dilation(ok, structure=np.ones((3, 3), bool)) & ~ok)
     for k in range(0, rows.size, 512):  # chunks: the test is (cells x segments) dense
