@@ -129,7 +129,7 @@ class FloodModel:
         self.volume_out = 0.0
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
                          "wall_reflections": 0, "density_unconverged": 0,
-                         "density_capped": 0}
+                         "density_capped": 0, "density_held": 0}
         self.bed = np.empty((0, 7))
         self.blocked = np.empty(0, dtype=np.bool_)
         self._blocked_nl = None
@@ -295,8 +295,9 @@ class FloodModel:
     def _solve_density(self, settle: bool = False) -> None:
         """The depth-density solve.
 
-        In a time step no h grows beyond what the neighbour lists hold
-        (``solve_density(cap=True)``). A particle held back by lists built at this step
+        In a time step no h grows beyond what the neighbour lists hold, nor shrinks below
+        ``density.H_SHRINK_MIN`` times its guess (``solve_density(cap=True)``; the counters
+        ``density_capped`` and ``density_held``). A particle held back by lists built at this step
         catches up over the next steps; if the lists are older, they are rebuilt and the solve
         repeated once. When the model is set up (``settle``), h may move far from the seeding
         guess, so the lists are rebuilt and the solve repeated until they hold (at most
@@ -307,7 +308,7 @@ class FloodModel:
         h_predicted = p.h.copy()
         for _ in range(SETTLE_ROUNDS if settle else 2):
             self._blocked_pairs()
-            _, bad, capped = density.solve_density(
+            _, bad, capped, held = density.solve_density(
                 p, self.nl, self.blocked, self.walls_near, self.seg, tol=num.density_tol,
                 max_iter=num.density_max_iter, h_ratio=num.h_ratio, cap=not settle)
             if settle and self.nl.still_valid(p.x, p.y, p.h):
@@ -318,6 +319,7 @@ class FloodModel:
         p.hgrow[:] = p.h / h_predicted
         self.counters["density_unconverged"] += bad
         self.counters["density_capped"] += capped
+        self.counters["density_held"] += held
 
     def _forces(self) -> None:
         p = self.particles

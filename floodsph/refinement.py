@@ -60,6 +60,9 @@ HEXAGON_MARGIN = 1.01
 lines to its daughters (a segment across such a line is closer than the radius itself)."""
 RELAX_RATE = 0.2
 """Fraction of the excess ln(h^2 rho / (SMOOTHING_EXCESS kappa^2 m)) removed per step."""
+EDGE_ALPHA = 0.8
+"""Particles with alpha_i < EDGE_ALPHA 2 rho_i (a kernel support short of neighbours: a wet/dry
+edge) are not relaxed (:func:`relax_smoothing`)."""
 SMOOTHING_EXCESS = 3.0
 """Split particles relax to h = sqrt(3) kappa sqrt(m / rho), not to the lattice value: on the
 coarse Ritter case (tests/test_refine.py) and the first 60 s of Malpasset this beat both no
@@ -302,10 +305,19 @@ def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE) -> None:
     Each step, ln C moves by ``rate`` of the way to ln(SMOOTHING_EXCESS kappa^2 m) where C
     exceeds it; h0 and the current h (the Newton guess) are rescaled alike, so the density
     solve follows in a few iterations and the excess is gone about 10 steps after a split.
+
+    Particles at a wet/dry edge keep their smoothing: those whose kernel support is short of
+    neighbours, alpha_i < EDGE_ALPHA 2 rho_i (alpha_i = 2 rho_i with full support on a
+    lattice, and 0 for a lone particle, whose density is its own term m_i W(0, h_i)). Changing
+    C is not part of the variational dynamics, so it does work on the water. Inside the water
+    that work is small, but at an edge shrinking h raises the particle's own term, which grows
+    as 1 / h^2, and with it the depth and the pressure that push the edge forward: the thin
+    front of a refined dam break ran at up to 28 m/s, 40 % above the bound 2 sqrt(g d0) of the
+    exact solution (``tests/test_refine.py``).
     """
     target = SMOOTHING_EXCESS * kappa * kappa * p.m
     c = p.h0 * p.h0 * p.rho0
-    over = np.flatnonzero(c > target * (1.0 + 1e-9))
+    over = np.flatnonzero((c > target * (1.0 + 1e-9)) & (p.alpha >= EDGE_ALPHA * 2.0 * p.rho))
     if over.size:
         f = np.sqrt((target[over] / c[over]) ** rate)
         p.h0[over] *= f

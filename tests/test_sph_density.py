@@ -25,8 +25,8 @@ def test_newton_converges_in_few_iterations_from_a_perturbed_guess():
     model = FloodModel(terrain, p, Numerics(spacing=2.0, kappa=1.3))
     p.rho[:] *= 1.05  # a guess 5 % off, as after a long step
     p.h[:] = p.h0 * np.sqrt(p.rho0 / p.rho)
-    iters, bad, _ = density.solve_density(p, model.nl, model.blocked, model.walls_near,
-                                          model.seg, tol=1e-6)
+    iters, bad, _, _ = density.solve_density(p, model.nl, model.blocked, model.walls_near,
+                                             model.seg, tol=1e-6)
     assert bad == 0
     assert iters <= 5
     # the self-consistent lattice depth differs from 3 m only by the lattice-sum error
@@ -80,8 +80,8 @@ def test_capped_solve_keeps_the_lists_valid_and_catches_up_after_a_rebuild():
     model._neighbours(force=True)
     model._blocked_pairs()
     cap = model.nl.h_cap(p.x, p.y)[i]
-    _, bad, capped = density.solve_density(p, model.nl, model.blocked, model.walls_near,
-                                           model.seg, cap=True)
+    _, bad, capped, _ = density.solve_density(p, model.nl, model.blocked, model.walls_near,
+                                              model.seg, cap=True)
     assert capped == 1 and bad == 0
     assert p.h[i] == pytest.approx(cap) and p.h[i] < 0.8 * p.h0[i]
     assert model.nl.still_valid(p.x, p.y, p.h)
@@ -93,3 +93,31 @@ def test_capped_solve_keeps_the_lists_valid_and_catches_up_after_a_rebuild():
         model._blocked_pairs()
         density.solve_density(p, model.nl, model.blocked, model.walls_near, model.seg, cap=True)
     assert p.rho[i] / 3000.0 == pytest.approx(1.0, abs=2e-3)
+
+
+def test_a_heavy_neighbour_brought_close_does_not_collapse_h_in_a_time_step():
+    """A particle ten times heavier (a merged one, say) lands 0.3 m from particle i of 0.5 m
+    still water at 5 m spacing. Equations (1)-(2) then have a second root at a tiny h, where
+    that neighbour's W(r, h) is near its peak (d_i about 110 m at h = h0 / 10). In a time step
+    the solve holds h_i at H_SHRINK_MIN times its guess and takes the summation there: the
+    depth of the root continuous with the old state (the neighbour adds about 2 m)."""
+    terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 100), (0, 100), 10.0)
+    x, y = lattice(0, 100, 0, 100, 5.0)
+    p = particles_with_depth(x, y, np.full(x.size, 0.5), 5.0, 1.3)
+    model = FloodModel(terrain, p, Numerics(spacing=5.0, kappa=1.3))
+    i = int(np.argmin(np.hypot(p.x - 52.5, p.y - 52.5)))
+    j = int(np.argmin(np.hypot(p.x - 57.5, p.y - 52.5)))
+    h_guess = p.h[i]
+    p.x[j] = p.x[i] + 0.05 * h_guess
+    p.y[j] = p.y[i]
+    p.m[j] *= 10.0
+    model._neighbours(force=True)
+    model._blocked_pairs()
+    _, bad, capped, held = density.solve_density(p, model.nl, model.blocked, model.walls_near,
+                                                 model.seg, cap=True)
+    assert bad == 0 and capped == 0 and held >= 1
+    assert p.h[i] == pytest.approx(density.H_SHRINK_MIN * h_guess, rel=1e-12)
+    rho_there, _ = density.summation(i, p.h[i], p.x, p.y, p.m, model.nl.start, model.nl.nbr,
+                                     model.blocked, *model.walls_near, model.seg)
+    assert p.rho[i] == pytest.approx(rho_there, rel=1e-12)
+    assert 2.0 < p.rho[i] / 1000.0 < 3.0

@@ -18,7 +18,13 @@ contribution alone can never match its density, cannot grow without bound. In ti
 h is also kept within what the Verlet neighbour list holds (its skin): a particle that would
 grow beyond it (a nearly isolated particle at a thin edge, whose solution can jump between
 two roots 20 % apart) takes the summation at that h and catches up over the next steps,
-instead of forcing a rebuild of every particle's list and a second solve.
+instead of forcing a rebuild of every particle's list and a second solve. Likewise no h
+shrinks in one step below ``H_SHRINK_MIN`` times its continuity guess: a particle that a
+merge or a wall brings within a fraction of its h of a heavy neighbour has a second,
+spurious root of (1)-(2) at a tiny h, where that neighbour's W(r, h) is near its peak. The
+solve fell into it (in a refined dam break a 0.42 m deep particle became 30 m deep with
+h = 0.9 m instead of 7.5 m in one step, and was shot off at 38 m/s, twice the bound
+2 sqrt(g d0)); held at the bound, the pair repels and separates over the next steps.
 Mirror images across walls (``floodsph.sph.walls``) are part of the summation.
 """
 
@@ -31,6 +37,11 @@ from numba import njit, prange
 
 from floodsph.sph.kernels import w_cubic, w_dwdr_cubic
 from floodsph.sph.walls import corner_image, wall_image
+
+H_SHRINK_MIN = 0.8
+"""In a time step, h_i >= H_SHRINK_MIN h_i(guess), i.e. rho_i at most 1.56 times its continuity
+guess: a CFL step (cfl <= 0.3) moves no particle more than 0.3 h, so a genuine compression
+stays well inside it."""
 
 
 @njit(inline="always", cache=True)
@@ -114,7 +125,7 @@ def _h_of_rho(h0, rho0, rho, h_ratio):
 
 @njit(parallel=True, cache=True)
 def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
-          seg, tol, max_iter, h_ratio, h_cap, iters):
+          seg, tol, max_iter, h_ratio, h_cap, h_shrink, iters):
     """Newton-Raphson solve (1)-(3) of every particle, in place (gather form).
 
     Only h_i changes the summation of particle i, so each particle iterates on its own to
@@ -123,7 +134,9 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
     A particle already within ``tol`` at the start h (below) keeps its rho; alpha is that of the
     last summation.
     A particle whose iterate would exceed ``h_cap[i]`` (the most its neighbour list holds)
-    stops at h_cap with the summation there, and ``iters[i]`` is set to 0 (capped).
+    stops at h_cap with the summation there, and ``iters[i]`` is set to 0 (capped). One whose
+    iterate would fall below ``h_shrink`` times its incoming h stops there with the summation
+    at that h, and ``iters[i]`` is set to ``max_iter + 1`` (held; ``h_shrink = 0``: no bound).
     The iteration starts from h_i = h(rho_i) of (2) (within the bounds and the cap), not from
     the h it comes with: a particle that last took a plain summation (capped, unconverged, or
     at a bound of h) carries an h that does not satisfy (2), and an isolated one, whose
@@ -134,10 +147,12 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
     for i in prange(x.shape[0]):
         it = 0
         done = False
+        h_low = h_shrink * h[i]
         h_rho = _h_of_rho(h0[i], rho0[i], rho[i], h_ratio)
         capped = h_rho > h_cap[i]
-        h[i] = min(h_rho, h_cap[i])
-        while it < max_iter and not capped:
+        held = h_rho < h_low
+        h[i] = min(max(h_rho, h_low), h_cap[i])
+        while it < max_iter and not capped and not held:
             s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
                              seg)
             alpha[i] = a
@@ -151,8 +166,9 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
                 new = s
             h_new = _h_of_rho(h0[i], rho0[i], new, h_ratio)
             capped = h_new > h_cap[i]
+            held = h_new < h_low
             rho[i] = new
-            h[i] = min(h_new, h_cap[i])
+            h[i] = min(max(h_new, h_low), h_cap[i])
         if done:
             iters[i] = it
         else:
@@ -160,7 +176,7 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
                              seg)
             rho[i] = s
             alpha[i] = a
-            iters[i] = 0 if capped else -it
+            iters[i] = 0 if capped else (max_iter + 1 if held else -it)
 
 
 @njit(parallel=True, cache=True)
@@ -179,15 +195,18 @@ def solve_density(p, nl, blocked, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.
     ``blocked`` its pairs separated by a wall (:func:`floodsph.sph.walls.blocked_pairs`);
     ``walls`` the near-wall lists (wstart, wseg, cstart, cpair) of
     :meth:`floodsph.sph.walls.WallIndex.near_lists`; ``seg`` the wall segments.
-    With ``cap``, no h grows beyond what ``nl`` holds (:meth:`NeighbourList.h_cap`), so the
-    lists stay valid through the solve.
+    With ``cap`` (a time step), no h grows beyond what ``nl`` holds (:meth:`NeighbourList.h_cap`),
+    so the lists stay valid through the solve, and none shrinks below ``H_SHRINK_MIN`` times its
+    guess (see the module docstring).
     On return every particle has rho, h and alpha consistent with its neighbours to ``tol``,
-    except the unconverged and the capped ones, which take the plain summation at their h.
-    Returns (iterations, unconverged, capped); ``iterations`` is the largest number of
+    except the unconverged, capped and held ones, which take the plain summation at their h.
+    Returns (iterations, unconverged, capped, held); ``iterations`` is the largest number of
     summations any particle needed.
     """
     iters = np.zeros(p.n, dtype=np.int64)
     h_cap = nl.h_cap(p.x, p.y) if cap else np.full(p.n, np.inf)
     solve(p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked, *walls, seg,
-          tol, max_iter, h_ratio, h_cap, iters)
-    return int(np.abs(iters).max(initial=0)), int((iters < 0).sum()), int((iters == 0).sum())
+          tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, iters)
+    held = iters > max_iter
+    return (int(np.abs(np.where(held, 0, iters)).max(initial=0)), int((iters < 0).sum()),
+            int((iters == 0).sum()), int(held.sum()))
