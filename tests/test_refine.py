@@ -358,6 +358,27 @@ def test_split_daughters_relax_to_sqrt3_lattice_smoothing_and_lattice_particles_
                                rtol=1e-5)
 
 
+def test_a_parent_passes_on_at_most_its_relaxed_smoothing():
+    """Daughters take 0.9 h_p, with h_p at most the relaxed sqrt(3) kappa sqrt(m_p / rho_p):
+    an unrelaxed edge parent does not hand its inflated h down a generation."""
+    from floodsph.refinement import SMOOTHING_EXCESS
+
+    model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
+    p = model.particles
+    kappa = model.numerics.kappa
+    centre = np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 1.0)
+    inflated, plain = centre[:2], centre[2:4]
+    p.h[inflated] *= 3.0
+    relaxed = math.sqrt(SMOOTHING_EXCESS) * kappa * np.sqrt(p.m / p.rho)
+    expect = refine.H_FACTOR * np.concatenate([relaxed[inflated], p.h[plain]])
+    n0 = p.n - 4
+    Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0).execute(
+        model, np.concatenate([inflated, plain]), [], [])
+    born_h = p.h[n0:].reshape(4, refine.DAUGHTERS)
+    np.testing.assert_allclose(born_h, np.repeat(expect[:, None], refine.DAUGHTERS, axis=1),
+                               rtol=1e-12)
+
+
 def test_a_small_particle_beside_a_large_one_still_finds_its_merge_partner():
     x = np.array([0.0, 1.0, 0.3])  # 0's nearest neighbour is 2, a large non-candidate
     y = np.zeros(3)

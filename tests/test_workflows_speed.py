@@ -1,6 +1,6 @@
 """``workflows/speed_vs_error.py`` and ``workflows/refinement_benchmark.py``, run briefly.
 
-The analytic part runs the coarse Stoker dam break in both default modes; the real cases
+The analytic part runs the coarse Stoker dam break in the three default modes; the real cases
 (third-party data, skipped when absent) run two steps per mode at their coarsest spacing,
 which checks the chain: run folders, the agreement with the reference run, the CSV, the
 markdown report and the picture.
@@ -31,7 +31,7 @@ def test_speed_vs_error_analytic_rows_and_report(tmp_path):
     speed.main(["--quick", "--cases", "stoker", "--no-throughput", "--out", str(tmp_path)])
     rows = _rows(tmp_path / "speed_vs_error.csv")
     assert [(r["case"], r["refinement"], r["spacing"]) for r in rows] == [
-        ("stoker", "none", "10"), ("stoker", "split+coalesce", "10")]
+        ("stoker", "none", "10"), ("stoker", "split", "10"), ("stoker", "split+coalesce", "10")]
     for r in rows:
         assert 0.0 < float(r["l1"]) < 0.015  # the coarse Stoker target of the core tests
         assert abs(float(r["front_error_m"])) <= 20.0 and float(r["mass_error_rel"]) < 1e-12
@@ -46,7 +46,7 @@ def test_speed_vs_error_real_cases_agree_with_their_reference(tmp_path):
     speed.main(["--quick", "--cases", "malpasset", "ea_test4", "--max-steps", "2",
                 "--no-throughput", "--out", str(tmp_path)])
     rows = _rows(tmp_path / "real_cases.csv")
-    assert {r["mode"] for r in rows} == {"none", "split+coalesce"}
+    assert {r["mode"] for r in rows} == {"none", "split", "split+coalesce"}
     for r in rows:
         assert r["reference"] == f"split+coalesce {r['spacing_m']} m"
         assert int(r["steps"]) == 2 and float(r["mass_error_rel"]) < 1e-12

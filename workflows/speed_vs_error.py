@@ -1,8 +1,9 @@
 """Speed against error of floodsph: analytic cases, real terrain, and raw solver throughput.
 
 * **Analytic cases** (``floodsph.verification``): Ritter and Stoker dam breaks and Thacker's
-  basin at three spacings each, in each refinement mode (default ``none`` and
-  ``split+coalesce``); the error is the L1 relative depth error against the exact solution.
+  basin at three spacings each, in each refinement mode (default: all three, ``none``,
+  ``split`` and ``split+coalesce``); the error is the L1 relative depth error against the
+  exact solution.
 * **Real cases**: Malpasset (``workflows/malpasset/scenario.toml``, 1000 s, the sea as
   particles) and EA Test 4 (``workflows/ea_test4``, 18000 s) at three particle spacings in
   each mode, through the real run chain (run folders, maps). Their observed values are held
@@ -20,7 +21,7 @@ Pareto view) and ``speed_vs_error.md`` (the report, with the command that made i
 are wall-clock on this machine: compare rows of one run, not runs on different days.
 
     python workflows/speed_vs_error.py [--out results/speed_vs_error] [--quick]
-        [--cases ritter stoker thacker malpasset ea_test4] [--modes none split+coalesce]
+        [--cases ritter stoker thacker malpasset ea_test4] [--modes none split split+coalesce]
         [--max-steps N] [--no-throughput]
     python workflows/speed_vs_error.py --throughput-only [--repeats 5] [--skin 0.3]
 
@@ -116,7 +117,7 @@ def main(argv=None) -> None:
     ap.add_argument("--out", type=Path, default=Path("results/speed_vs_error"))
     ap.add_argument("--quick", action="store_true", help="one coarse spacing per case")
     ap.add_argument("--cases", nargs="+", choices=[*ANALYTIC, *REAL], default=[*ANALYTIC, *REAL])
-    ap.add_argument("--modes", nargs="+", choices=MODES, default=["none", "split+coalesce"])
+    ap.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES))
     ap.add_argument("--max-steps", type=int, default=None, help="real cases: stop after N steps")
     ap.add_argument("--throughput-only", action="store_true", help="only the throughput blocks")
     ap.add_argument("--no-throughput", action="store_true", help="skip the throughput blocks")
