@@ -22,7 +22,7 @@ are wall-clock on this machine: compare rows of one run, not runs on different d
 
     python workflows/speed_vs_error.py [--out results/speed_vs_error] [--quick]
         [--cases ritter stoker thacker malpasset ea_test4] [--modes none split split+coalesce]
-        [--max-steps N] [--no-throughput]
+        [--max-steps N] [--real-spacings DX [DX ...]] [--no-throughput]
     python workflows/speed_vs_error.py --throughput-only [--repeats 5] [--skin 0.3]
 
 Throughput: every kernel is compiled on a small block first, the big block is built and
@@ -119,6 +119,8 @@ def main(argv=None) -> None:
     ap.add_argument("--cases", nargs="+", choices=[*ANALYTIC, *REAL], default=[*ANALYTIC, *REAL])
     ap.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES))
     ap.add_argument("--max-steps", type=int, default=None, help="real cases: stop after N steps")
+    ap.add_argument("--real-spacings", nargs="+", type=float, default=None,
+                    help="particle spacings [m] of the real cases (default: each case's three)")
     ap.add_argument("--throughput-only", action="store_true", help="only the throughput blocks")
     ap.add_argument("--no-throughput", action="store_true", help="skip the throughput blocks")
     ap.add_argument("--repeats", type=int, default=3, help="timed blocks per throughput case")
@@ -137,7 +139,8 @@ def main(argv=None) -> None:
                     rows.append(cases.CASES[name](dx, refinement=_refinement(mode)))
                     print_row(rows[-1])
         for name in (c for c in args.cases if c in REAL):
-            real += real_case(name, out / name, args.modes, args.quick, args.max_steps)
+            real += real_case(name, out / name, args.modes, args.quick, args.max_steps,
+                              args.real_spacings)
     speed = []
     if not args.no_throughput:
         numerics = {} if args.skin is None else {"neighbour_skin": args.skin}
@@ -181,13 +184,16 @@ def real_scenario(case: str, out: Path) -> Path | None:
     return ea4.write_inputs(folder, out, end_time, 5, 5.0)
 
 
-def real_case(case: str, out: Path, modes, quick: bool, max_steps: int | None) -> list[dict]:
-    """Runs of a real case at its spacings in each mode, with their agreement with the
-    finest ``split+coalesce`` run (or the finest run of the first mode without it)."""
+def real_case(case: str, out: Path, modes, quick: bool, max_steps: int | None,
+              spacings=None) -> list[dict]:
+    """Runs of a real case at its spacings (``spacings``, default the case's own) in each
+    mode, with their agreement with the finest ``split+coalesce`` run (or the finest run of
+    the first mode without it)."""
     path = real_scenario(case, out)
     if path is None:
         return []
-    spacings = REAL[case]["spacings"][:1] if quick else REAL[case]["spacings"]
+    spacings = spacings or REAL[case]["spacings"]
+    spacings = spacings[:1] if quick else spacings
     rows = []
     for dx in spacings:
         for mode in modes:
