@@ -301,7 +301,8 @@ def test_the_thin_front_of_a_refined_dam_break_keeps_below_the_riemann_bound():
     faster than the front's exact speed 2 sqrt(g d0) = 19.8 m/s (the Riemann invariant
     u + 2 sqrt(g d) is 2 sqrt(g d0) throughout the exact solution). Before edge particles
     were exempt from the smoothing relaxation and h was held in the density solve, the
-    front reached 26 m/s at t = 22 s and a particle pushed into a side wall 38 m/s."""
+    fastest particle reached 26 m/s (t = 22 s); with the exemption alone, a particle whose
+    solve collapsed beside a heavy merged neighbour at a side wall reached 38 m/s."""
     from floodsph.constants import GRAVITY
 
     model = cases._lattice_model(flat, (0, 2000), (0, 100), 10.0,
