@@ -132,6 +132,7 @@ class FloodModel:
                          "density_capped": 0, "density_held": 0}
         self.bed = np.empty((0, 7))
         self.blocked = np.empty(0, dtype=np.bool_)
+        self.wdist = np.empty(0)
         self._blocked_nl = None
         self._nl_fresh = False  # lists built in this step
         for boundary in self.boundaries:
@@ -284,13 +285,16 @@ class FloodModel:
                                                      self.nl.nbr, self.nl.reach)
 
     def _blocked_pairs(self) -> None:
-        """Flag the listed pairs that a wall separates, at the current positions."""
+        """Flag the listed pairs that a wall separates, and measure the distances to the near
+        segments, at the current positions."""
         p = self.particles
         self._blocked_nl = self.nl
         if self.blocked.shape[0] != self.nl.nbr.shape[0]:
             self.blocked = np.empty(self.nl.nbr.shape[0], dtype=np.bool_)
+        if self.wdist.shape[0] != self.walls_near[1].shape[0]:
+            self.wdist = np.empty(self.walls_near[1].shape[0])
         wallmod.blocked_pairs(p.x, p.y, self.nl.start, self.nl.nbr, *self.walls_near[:2],
-                              self.seg, self.blocked)
+                              self.seg, self.blocked, self.wdist)
 
     def _solve_density(self, settle: bool = False) -> None:
         """The depth-density solve.
@@ -309,8 +313,9 @@ class FloodModel:
         for _ in range(SETTLE_ROUNDS if settle else 2):
             self._blocked_pairs()
             _, bad, capped, held = density.solve_density(
-                p, self.nl, self.blocked, self.walls_near, self.seg, tol=num.density_tol,
-                max_iter=num.density_max_iter, h_ratio=num.h_ratio, cap=not settle)
+                p, self.nl, self.blocked, self.wdist, self.walls_near, self.seg,
+                tol=num.density_tol, max_iter=num.density_max_iter, h_ratio=num.h_ratio,
+                cap=not settle)
             if settle and self.nl.still_valid(p.x, p.y, p.h):
                 break
             if not settle and (capped == 0 or self._nl_fresh):
@@ -330,8 +335,8 @@ class FloodModel:
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
             self._blocked_pairs()
         forces.internal_acceleration(p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, self.nl.start,
-                                     self.nl.nbr, self.blocked, *self.walls_near, self.seg,
-                                     self.scheme, p.ax, p.ay, p.divv)
+                                     self.nl.nbr, self.blocked, self.wdist, *self.walls_near,
+                                     self.seg, self.scheme, p.ax, p.ay, p.divv)
         forces.add_bed_acceleration(p.u, p.v, self.bed, self.numerics.max_slope, p.ax, p.ay)
 
 

@@ -9,6 +9,19 @@ from floodsph.sph import density
 from floodsph.terrain import Terrain
 
 
+def solve(model, **kwargs):
+    """``density.solve_density`` on the model's particles, lists and walls."""
+    return density.solve_density(model.particles, model.nl, model.blocked, model.wdist,
+                                 model.walls_near, model.seg, **kwargs)
+
+
+def summation(model, i):
+    """(rho_i, alpha_i) of the density summation at particle i's current h."""
+    p = model.particles
+    return density.summation(i, p.h[i], p.x, p.y, p.m, model.nl.start, model.nl.nbr,
+                             model.blocked, model.wdist, *model.walls_near, model.seg)
+
+
 def test_uniform_lattice_in_closed_box_gives_exact_depth_everywhere():
     """Mirror images (walls and corners) complete the kernel: exact depth up to the walls."""
     model = model_on(lambda x, y: 0 * x, (0, 200), (0, 150), 10.0, 2.0, 5.0)
@@ -25,8 +38,7 @@ def test_newton_converges_in_few_iterations_from_a_perturbed_guess():
     model = FloodModel(terrain, p, Numerics(spacing=2.0, kappa=1.3))
     p.rho[:] *= 1.05  # a guess 5 % off, as after a long step
     p.h[:] = p.h0 * np.sqrt(p.rho0 / p.rho)
-    iters, bad, _, _ = density.solve_density(p, model.nl, model.blocked, model.walls_near,
-                                             model.seg, tol=1e-6)
+    iters, bad, _, _ = solve(model, tol=1e-6)
     assert bad == 0
     assert iters <= 5
     # the self-consistent lattice depth differs from 3 m only by the lattice-sum error
@@ -80,18 +92,16 @@ def test_capped_solve_keeps_the_lists_valid_and_catches_up_after_a_rebuild():
     model._neighbours(force=True)
     model._blocked_pairs()
     cap = model.nl.h_cap(p.x, p.y)[i]
-    _, bad, capped, _ = density.solve_density(p, model.nl, model.blocked, model.walls_near,
-                                              model.seg, cap=True)
+    _, bad, capped, _ = solve(model, cap=True)
     assert capped == 1 and bad == 0
     assert p.h[i] == pytest.approx(cap) and p.h[i] < 0.8 * p.h0[i]
     assert model.nl.still_valid(p.x, p.y, p.h)
-    rho_at_cap, _ = density.summation(i, p.h[i], p.x, p.y, p.m, model.nl.start, model.nl.nbr,
-                                      model.blocked, *model.walls_near, model.seg)
+    rho_at_cap, _ = summation(model, i)
     assert p.rho[i] == pytest.approx(rho_at_cap, rel=1e-12)
     for _ in range(5):
         model._neighbours(force=True)
         model._blocked_pairs()
-        density.solve_density(p, model.nl, model.blocked, model.walls_near, model.seg, cap=True)
+        solve(model, cap=True)
     assert p.rho[i] / 3000.0 == pytest.approx(1.0, abs=2e-3)
 
 
@@ -113,11 +123,9 @@ def test_a_heavy_neighbour_brought_close_does_not_collapse_h_in_a_time_step():
     p.m[j] *= 10.0
     model._neighbours(force=True)
     model._blocked_pairs()
-    _, bad, capped, held = density.solve_density(p, model.nl, model.blocked, model.walls_near,
-                                                 model.seg, cap=True)
+    _, bad, capped, held = solve(model, cap=True)
     assert bad == 0 and capped == 0 and held >= 1
     assert p.h[i] == pytest.approx(density.H_SHRINK_MIN * h_guess, rel=1e-12)
-    rho_there, _ = density.summation(i, p.h[i], p.x, p.y, p.m, model.nl.start, model.nl.nbr,
-                                     model.blocked, *model.walls_near, model.seg)
+    rho_there, _ = summation(model, i)
     assert p.rho[i] == pytest.approx(rho_there, rel=1e-12)
     assert 2.0 < p.rho[i] / 1000.0 < 3.0

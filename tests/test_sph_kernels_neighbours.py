@@ -130,9 +130,9 @@ def test_verlet_lists_kept_over_steps_give_the_flow_of_lists_rebuilt_every_step(
 
 
 def test_wall_lists_equal_a_brute_force_search():
-    """Segments longer than the buckets, diagonal ones, radii spanning several buckets:
-    every segment within reach is listed once, in index order, with its right-angled corners
-    and the pairs it blocks."""
+    """Segments longer than the buckets, diagonal ones, radii spanning several buckets and
+    the coarse levels of the bucket pyramid: every segment within reach is listed once, in
+    index order, with its distance, its right-angled corners and the pairs it blocks."""
     from floodsph.sph import walls
 
     rng = np.random.default_rng(7)
@@ -144,11 +144,14 @@ def test_wall_lists_equal_a_brute_force_search():
     n = 3000
     x, y = rng.uniform(-30.0, 430.0, n), rng.uniform(-30.0, 430.0, n)
     h = rng.uniform(2.0, 40.0, n)
+    h[::300] = 300.0  # lone thin particles: they and their neighbours query the coarse levels
     nl = NeighbourList(x, y, h)
     index = walls.WallIndex(seg, (0.0, 0.0, 400.0, 400.0), bucket=15.0)
+    assert index.lv_bucket.size == 6  # 15 m to 480 m buckets
     wstart, wseg, cstart, cpair = index.near_lists(x, y, h, nl.start, nl.nbr, nl.reach)
     blocked = np.empty(nl.nbr.size, dtype=np.bool_)
-    walls.blocked_pairs(x, y, nl.start, nl.nbr, wstart, wseg, seg, blocked)
+    wdist = np.empty(wseg.size)
+    walls.blocked_pairs(x, y, nl.start, nl.nbr, wstart, wseg, seg, blocked, wdist)
     assert cpair.shape[0] > 50 and blocked.sum() > 100
     for i in range(0, n, 7):
         nbrs = nl.nbr[nl.start[i]:nl.start[i + 1]]
@@ -156,6 +159,7 @@ def test_wall_lists_equal_a_brute_force_search():
         dist = np.array([walls.segment_distance(x[i], y[i], *s) for s in seg])
         near = np.flatnonzero(dist < radius)
         np.testing.assert_array_equal(wseg[wstart[i]:wstart[i + 1]], near)
+        np.testing.assert_allclose(wdist[wstart[i]:wstart[i + 1]], dist[near], rtol=1e-12)
         corners = [[a, b] for k, a in enumerate(near) for b in near[k + 1:]
                    if {tuple(seg[a, :2]), tuple(seg[a, 2:])} & {tuple(seg[b, :2]),
                                                                 tuple(seg[b, 2:])}
@@ -181,7 +185,7 @@ def test_bucket_clearance_bounds_the_wall_distance_and_keeps_lists_exact():
     n = 4000
     x, y = rng.uniform(0.0, 800.0, n), rng.uniform(0.0, 800.0, n)
     dist = np.array([[walls.segment_distance(x[i], y[i], *s) for s in seg] for i in range(n)])
-    b = (y // 20.0).astype(int) * index.nbx + (x // 20.0).astype(int)
+    b = (y // 20.0).astype(int) * index.lv_nbx[0] + (x // 20.0).astype(int)
     assert np.all(dist.min(axis=1) >= index.clear[b])
     assert np.mean(index.clear > 0.0) > 0.7
     h = rng.uniform(5.0, 30.0, n)

@@ -36,7 +36,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import w_cubic, w_dwdr_cubic
-from floodsph.sph.walls import corner_image, wall_image
+from floodsph.sph.walls import SIGHT_SLACK, corner_image, wall_image
 
 H_SHRINK_MIN = 0.8
 """In a time step, h_i >= H_SHRINK_MIN h_i(guess), i.e. rho_i at most 1.56 times its continuity
@@ -69,12 +69,14 @@ def _corner(i, j, x, y, m, hi, seg, s1, s2):
 
 
 @njit(inline="always", cache=True)
-def summation(i, hi, x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair, seg):
+def summation(i, hi, x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart, cpair, seg):
     """Density summation (1) and alpha_i of particle i at smoothing length ``hi``.
 
     Returns (sum_j m_j W(r_ij, h_i), alpha_i), self and mirror images included; listed
     neighbours beyond the support 2 h_i are skipped (W = 0 there). Pairs flagged in
     ``blocked`` (:func:`floodsph.sph.walls.blocked_pairs`) are left out with their images.
+    A segment farther than 2 h_i from i (``wdist``, of the same function) makes no image
+    within the support, so its single images are skipped (the sum is unchanged).
     Images are summed segment by segment, each segment followed by the corners it opens
     (``cpair`` lists them in that order), so the sum does not depend on list order.
     """
@@ -83,6 +85,7 @@ def summation(i, hi, x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
     rsum = m[i] * w_cubic(0.0, hi)
     alpha = 0.0
     support2 = 4.0 * hi * hi
+    reach = 2.0 * hi + SIGHT_SLACK
     for q in range(nstart[i], nstart[i + 1]):
         j = nbr[q]
         rx = xi - x[j]
@@ -95,14 +98,15 @@ def summation(i, hi, x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
     c = cstart[i]
     for k in range(wstart[i], wstart[i + 1]):
         s = wseg[k]
-        w, a = _image(i, i, x, y, m, hi, seg, s)
-        rsum += w
-        alpha -= a
-        for q in range(nstart[i], nstart[i + 1]):
-            if not blocked[q]:
-                w, a = _image(i, nbr[q], x, y, m, hi, seg, s)
-                rsum += w
-                alpha -= a
+        if wdist[k] < reach:
+            w, a = _image(i, i, x, y, m, hi, seg, s)
+            rsum += w
+            alpha -= a
+            for q in range(nstart[i], nstart[i + 1]):
+                if not blocked[q]:
+                    w, a = _image(i, nbr[q], x, y, m, hi, seg, s)
+                    rsum += w
+                    alpha -= a
         while c < cstart[i + 1] and cpair[c, 0] == s:
             s2 = cpair[c, 1]
             w, a = _corner(i, i, x, y, m, hi, seg, s, s2)
@@ -124,8 +128,8 @@ def _h_of_rho(h0, rho0, rho, h_ratio):
 
 
 @njit(parallel=True, cache=True)
-def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
-          seg, tol, max_iter, h_ratio, h_cap, h_shrink, iters):
+def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
+          cpair, seg, tol, max_iter, h_ratio, h_cap, h_shrink, iters):
     """Newton-Raphson solve (1)-(3) of every particle, in place (gather form).
 
     Only h_i changes the summation of particle i, so each particle iterates on its own to
@@ -153,8 +157,8 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
         held = h_rho < h_low
         h[i] = min(max(h_rho, h_low), h_cap[i])
         while it < max_iter and not capped and not held:
-            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
-                             seg)
+            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
+                             cpair, seg)
             alpha[i] = a
             it += 1
             res = rho[i] - s
@@ -172,8 +176,8 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wstart, wseg, 
         if done:
             iters[i] = it
         else:
-            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wstart, wseg, cstart, cpair,
-                             seg)
+            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
+                             cpair, seg)
             rho[i] = s
             alpha[i] = a
             iters[i] = 0 if capped else (max_iter + 1 if held else -it)
@@ -188,12 +192,14 @@ def predict(rho, h, divv, dt):
         h[i] *= 1.0 / math.sqrt(f)
 
 
-def solve_density(p, nl, blocked, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0, cap=False):
+def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0,
+                  cap=False):
     """Solve (1)-(3) for all particles of ``p`` in place.
 
     ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList;
-    ``blocked`` its pairs separated by a wall (:func:`floodsph.sph.walls.blocked_pairs`);
-    ``walls`` the near-wall lists (wstart, wseg, cstart, cpair) of
+    ``blocked`` its pairs separated by a wall and ``wdist`` the distances to the near
+    segments (both from :func:`floodsph.sph.walls.blocked_pairs`); ``walls`` the near-wall
+    lists (wstart, wseg, cstart, cpair) of
     :meth:`floodsph.sph.walls.WallIndex.near_lists`; ``seg`` the wall segments.
     With ``cap`` (a time step), no h grows beyond what ``nl`` holds (:meth:`NeighbourList.h_cap`),
     so the lists stay valid through the solve, and none shrinks below ``H_SHRINK_MIN`` times its
@@ -205,8 +211,8 @@ def solve_density(p, nl, blocked, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.
     """
     iters = np.zeros(p.n, dtype=np.int64)
     h_cap = nl.h_cap(p.x, p.y) if cap else np.full(p.n, np.inf)
-    solve(p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked, *walls, seg,
-          tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, iters)
+    solve(p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked, wdist,
+          *walls, seg, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, iters)
     held = iters > max_iter
     return (int(np.abs(np.where(held, 0, iters)).max(initial=0)), int((iters < 0).sum()),
             int((iters == 0).sum()), int(held.sum()))

@@ -48,7 +48,7 @@ from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.kernels import dwdr_over_r_cubic, dwdr_over_r_floored
-from floodsph.sph.walls import corner_image, mirror, wall_image
+from floodsph.sph.walls import SIGHT_SLACK, corner_image, mirror, wall_image
 
 LAX_FRIEDRICHS = 0
 RIEMANN = 1
@@ -129,13 +129,15 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, image=False):
 
 
 @njit(parallel=True, cache=True)
-def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wstart, wseg, cstart,
-                          cpair, seg, scheme, ax, ay, divv):
+def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wdist, wstart, wseg,
+                          cstart, cpair, seg, scheme, ax, ay, divv):
     """a^int and div v of every particle (gather form), mirror images included.
 
     Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
     flagged in ``blocked`` (:func:`floodsph.sph.walls.blocked_pairs`) are left out with
-    their images. The wall lists (wstart, wseg, cstart, cpair) are those of
+    their images, and a segment's single images skip the neighbours j whose pair support
+    2 max(h_i, h_j) does not reach it (``wdist``, of the same function). The wall lists
+    (wstart, wseg, cstart, cpair) are those of
     :meth:`floodsph.sph.walls.WallIndex.near_lists`; images are summed segment by segment,
     each followed by the corners it opens, as in the density summation.
     """
@@ -148,10 +150,12 @@ def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, ws
         fx = 0.0
         fy = 0.0
         fd = 0.0
+        h_reach = hi  # the largest h of i and its neighbours: no image beyond 2 h_reach
         for q in range(nstart[i], nstart[i + 1]):
             j = nbr[q]
             rx = xi - x[j]
             ry = yi - y[j]
+            h_reach = max(h_reach, h[j])
             hm = 2.0 * max(hi, h[j])
             if rx * rx + ry * ry >= hm * hm or blocked[q]:
                 continue
@@ -163,11 +167,12 @@ def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, ws
         c = cstart[i]
         for w in range(wstart[i], wstart[i + 1]):
             s = wseg[w]
-            fx, fy, fd = _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v, m,
-                                          rho, h, coef, seg, s, -1, scheme)
+            if wdist[w] < 2.0 * h_reach + SIGHT_SLACK:
+                fx, fy, fd = _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v,
+                                              m, rho, h, coef, seg, s, -1, wdist[w], scheme)
             while c < cstart[i + 1] and cpair[c, 0] == s:
                 fx, fy, fd = _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v,
-                                              m, rho, h, coef, seg, s, cpair[c, 1], scheme)
+                                              m, rho, h, coef, seg, s, cpair[c, 1], 0.0, scheme)
                 c += 1
         ax[i] = fx
         ay[i] = fy
@@ -176,18 +181,25 @@ def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, ws
 
 @njit(inline="always", cache=True)
 def _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, seg, s, s2,
-                     scheme):
+                     ds, scheme):
     """Subtract from (fx, fy, fd) the pair terms on particle i of the images of i and of its
-    unblocked neighbours about segment s (s2 < 0) or about the corner of s and s2."""
-    if s2 < 0:
-        gx, gy, gd = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
-    else:
-        gx, gy, gd = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-    fx -= gx
-    fy -= gy
-    fd -= gd
+    unblocked neighbours about segment s (s2 < 0) or about the corner of s and s2.
+
+    ``ds`` is the distance [m] from i to segment s (0 for a corner): the image of j about s
+    is at least ds - SIGHT_SLACK from i, so for ds >= 2 max(h_i, h_j) + SIGHT_SLACK its pair
+    term is zero and is skipped.
+    """
+    hi = h[i]
+    if ds < 2.0 * hi + SIGHT_SLACK:
+        if s2 < 0:
+            gx, gy, gd = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
+        else:
+            gx, gy, gd = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
+        fx -= gx
+        fy -= gy
+        fd -= gd
     for q in range(nstart[i], nstart[i + 1]):
-        if blocked[q]:
+        if blocked[q] or ds >= 2.0 * max(hi, h[nbr[q]]) + SIGHT_SLACK:
             continue
         if s2 < 0:
             gx, gy, gd = _image_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, scheme)

@@ -59,46 +59,54 @@ def box_polyline(xmin, ymin, xmax, ymax) -> np.ndarray:
 
 
 class WallIndex:
-    """Static buckets of wall segments for fast near-wall queries.
+    """Static buckets of wall segments for fast near-wall queries, on a pyramid of grids.
 
-    Each square bucket of side ``bucket`` lists the segments whose bounding box overlaps it
-    (buckets beyond the domain's bounds are clamped to the outermost ones). A query of any
-    radius visits the buckets its square overlaps and takes each segment in the first of them
-    that the segment and the query square share (:func:`query_box`, :func:`first_visit`), so
-    no segment is seen twice and the cost follows the walls near the point, not their total.
+    Level L is a grid of square buckets of side ``bucket * 2**L``, up to one bucket over the
+    domain; each bucket lists the segments whose bounding box overlaps it (buckets beyond the
+    domain's bounds are clamped to the outermost ones). A query of radius R walks the finest
+    level whose buckets are at least R wide (at most 3 x 3 buckets, however large R: a lone
+    thin particle's smoothing length can be ten times the others', and every neighbour of it
+    queries that far). It takes each segment in the first of its buckets that the segment and
+    the query square share (:func:`query_box`, :func:`first_visit`), so no segment is seen
+    twice and the cost follows the walls near the point, not their total.
 
-    ``clear[b]`` is a lower bound [m] on the distance from any point of bucket b to any
-    segment: with e_b the Euclidean distance, in buckets, from b's centre to the centre of the
-    nearest bucket that lists a segment (a distance transform of the bucket grid), two points
-    in the two buckets are at least (e_b - sqrt 2) bucket apart. A particle whose radius is
-    below it has no near segment and skips the bucket walk.
+    ``clear[b]`` is a lower bound [m] on the distance from any point of bucket b of level 0 to
+    any segment: with e_b the Euclidean distance, in buckets, from b's centre to the centre of
+    the nearest bucket that lists a segment (a distance transform of the bucket grid), two
+    points in the two buckets are at least (e_b - sqrt 2) bucket apart. A particle whose
+    radius is below it has no near segment and skips the bucket walk.
     """
 
     def __init__(self, seg: np.ndarray, bounds, bucket: float):
         self.seg = np.ascontiguousarray(seg, dtype=np.float64).reshape(-1, 4)
         xmin, ymin, xmax, ymax = bounds
         self.xmin, self.ymin = float(xmin), float(ymin)
-        self.bucket = float(bucket)
-        self.nbx = max(1, int((xmax - xmin) / bucket) + 1)
-        self.nby = max(1, int((ymax - ymin) / bucket) + 1)
-        lists = [[] for _ in range(self.nbx * self.nby)]
-        for s, (x1, y1, x2, y2) in enumerate(self.seg):
-            bx0, bx1, by0, by1 = query_box(min(x1, x2), min(y1, y2), max(x1, x2), max(y1, y2),
-                                           *self.grid)
-            for by in range(by0, by1 + 1):
-                for bx in range(bx0, bx1 + 1):
-                    lists[by * self.nbx + bx].append(s)
-        counts = np.array([len(v) for v in lists], dtype=np.int64)
-        self.start = np.zeros(len(lists) + 1, dtype=np.int64)
-        np.cumsum(counts, out=self.start[1:])
-        self.items = np.array([s for v in lists for s in v], dtype=np.int64)
-        self.clear = _clearance(counts.reshape(self.nby, self.nbx) > 0, self.bucket)
+        sizes, shapes, counts, items = [], [], [], []
+        size = float(bucket)
+        while True:
+            nbx = max(1, int((xmax - xmin) / size) + 1)
+            nby = max(1, int((ymax - ymin) / size) + 1)
+            level_counts, level_items = _bucket_lists(self.seg, self.xmin, self.ymin, size,
+                                                      nbx, nby)
+            sizes.append(size)
+            shapes.append((nbx, nby))
+            counts.append(level_counts)
+            items.append(level_items)
+            if nbx == 1 and nby == 1:
+                break
+            size *= 2.0
+        self.lv_bucket = np.array(sizes)
+        self.lv_nbx = np.array([c for c, _ in shapes], dtype=np.int64)
+        self.lv_nby = np.array([r for _, r in shapes], dtype=np.int64)
+        self.lv_off = np.zeros(len(sizes) + 1, dtype=np.int64)
+        np.cumsum(self.lv_nbx * self.lv_nby, out=self.lv_off[1:])
+        self.start = np.zeros(self.lv_off[-1] + 1, dtype=np.int64)
+        np.cumsum(np.concatenate(counts), out=self.start[1:])
+        self.items = np.concatenate(items)
+        nbx, nby = shapes[0]
+        self.clear = _clearance(counts[0].reshape(nby, nbx) > 0, sizes[0])
+        self.pstart, self.partner = _corner_partners(self.seg)
         self.width = 16  # row width of the near-segment scan, widened when a row overflows
-
-    @property
-    def grid(self) -> tuple:
-        """(xmin, ymin, bucket, nbx, nby): the bucket grid, as the kernels take it."""
-        return self.xmin, self.ymin, self.bucket, self.nbx, self.nby
 
     def near_lists(self, x, y, h, nstart, nbr, reach):
         """CSR lists of the segments within each particle's reach, and of its wall corners.
@@ -116,7 +124,7 @@ class WallIndex:
             return (wstart, np.zeros(0, dtype=np.int64), cstart,
                     np.zeros((0, 2), dtype=np.int64))
         args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items, self.clear,
-                *self.grid)
+                self.xmin, self.ymin, self.lv_bucket, self.lv_nbx, self.lv_nby, self.lv_off)
         count = np.empty(n, dtype=np.int64)
         while True:  # one scan into rows of ``width``; again, wider, if a row overflowed
             rows = np.empty((n, self.width), dtype=np.int64)
@@ -128,11 +136,33 @@ class WallIndex:
         np.cumsum(count, out=wstart[1:])
         wseg = np.empty(wstart[-1], dtype=np.int64)
         _gather_rows(rows, wstart, wseg)
-        _corner_scan(wstart, wseg, self.seg, cstart, np.zeros((0, 2), dtype=np.int64), False)
+        corners = (wstart, wseg, self.pstart, self.partner, cstart)
+        _corner_scan(*corners, np.zeros((0, 2), dtype=np.int64), False)
         np.cumsum(cstart, out=cstart)
         cpair = np.empty((cstart[-1], 2), dtype=np.int64)
-        _corner_scan(wstart, wseg, self.seg, cstart, cpair, True)
+        _corner_scan(*corners, cpair, True)
         return wstart, wseg, cstart, cpair
+
+
+def _bucket_lists(seg: np.ndarray, xmin: float, ymin: float, bucket: float, nbx: int,
+                  nby: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per bucket of one grid (flat, row-major), the count of the segments whose bounding box
+    overlaps it, and those segments bucket by bucket in increasing index (bucket ranges as in
+    :func:`query_box`)."""
+    lo = np.minimum(seg[:, :2], seg[:, 2:])
+    hi = np.maximum(seg[:, :2], seg[:, 2:])
+    b0 = np.floor_divide(lo - (xmin, ymin), bucket)
+    b1 = np.floor_divide(hi - (xmin, ymin), bucket)
+    top = np.array([nbx - 1, nby - 1])
+    b0 = np.clip(b0, 0, top).astype(np.int64)
+    b1 = np.clip(b1, 0, top).astype(np.int64)
+    wide = b1[:, 0] - b0[:, 0] + 1
+    cover = wide * (b1[:, 1] - b0[:, 1] + 1)
+    sid = np.repeat(np.arange(seg.shape[0]), cover)
+    k = np.arange(sid.size) - np.repeat(np.cumsum(cover) - cover, cover)
+    b = (b0[sid, 1] + k // wide[sid]) * nbx + b0[sid, 0] + k % wide[sid]
+    order = np.argsort(b, kind="stable")
+    return np.bincount(b, minlength=nbx * nby), sid[order]
 
 
 def _clearance(occupied: np.ndarray, bucket: float) -> np.ndarray:
@@ -176,28 +206,37 @@ def first_visit(seg, s, bx, by, qbx0, qby0, xmin, ymin, bucket, nbx, nby):
 
 
 @njit(parallel=True, cache=True)
-def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, xmin, ymin, bucket, nbx,
-               nby, rows, count):
+def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, xmin, ymin, lv_bucket,
+               lv_nbx, lv_nby, lv_off, rows, count):
     """Count (into ``count[i]``) and list (into ``rows[i]``, in index order, as far as the row
     is wide) each particle's segments within reach * max(h_i, max_j h_j); a particle inside
-    the bucket grid whose radius is below its bucket's ``clear`` distance has none."""
+    the level-0 grid whose radius is below its bucket's ``clear`` distance has none. The
+    buckets walked are those of the finest level at least as wide as the radius."""
     width = rows.shape[1]
+    top = lv_bucket.shape[0] - 1
     for i in prange(x.shape[0]):
         count[i] = 0
         hr = h[i]
         for k in range(nstart[i], nstart[i + 1]):
             hr = max(hr, h[nbr[k]])
         radius = reach * hr
-        cx = (x[i] - xmin) / bucket
-        cy = (y[i] - ymin) / bucket
-        if 0.0 <= cx < nbx and 0.0 <= cy < nby and radius < clear[int(cy) * nbx + int(cx)]:
+        cx = (x[i] - xmin) / lv_bucket[0]
+        cy = (y[i] - ymin) / lv_bucket[0]
+        if (0.0 <= cx < lv_nbx[0] and 0.0 <= cy < lv_nby[0]
+                and radius < clear[int(cy) * lv_nbx[0] + int(cx)]):
             continue
+        lv = 0
+        while lv < top and lv_bucket[lv] < radius:
+            lv += 1
+        bucket = lv_bucket[lv]
+        nbx = lv_nbx[lv]
+        nby = lv_nby[lv]
         bx0, bx1, by0, by1 = query_box(x[i] - radius, y[i] - radius, x[i] + radius,
                                        y[i] + radius, xmin, ymin, bucket, nbx, nby)
         k = 0
         for by in range(by0, by1 + 1):
             for bx in range(bx0, bx1 + 1):
-                b = by * nbx + bx
+                b = lv_off[lv] + by * nbx + bx
                 for q in range(bstart[b], bstart[b + 1]):
                     s = items[q]
                     if not first_visit(seg, s, bx, by, bx0, by0, xmin, ymin, bucket, nbx, nby):
@@ -257,24 +296,64 @@ def share_vertex(seg, s1, s2):
     return False
 
 
+def _corner_partners(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """CSR table of the right corners of the walls: segment s meets the segments
+    ``partner[pstart[s]:pstart[s + 1]]`` (each of higher index, in increasing order) at a
+    right angle (:func:`right_corner`). Walls are static, so this is found once, and a
+    particle's corners are then looked up among its near segments (:func:`_corner_scan`)."""
+    ns = seg.shape[0]
+    ends = seg.reshape(2 * ns, 2)  # rows 2 s and 2 s + 1: the two ends of segment s
+    _, vertex = np.unique(ends, axis=0, return_inverse=True)
+    vertex = vertex.ravel()
+    order = np.argsort(vertex, kind="stable")
+    cut = np.flatnonzero(np.diff(vertex[order])) + 1
+    pairs = set()
+    for group in np.split(order // 2, cut):
+        for a in range(group.size):
+            for b in range(a + 1, group.size):
+                s1, s2 = sorted((int(group[a]), int(group[b])))
+                if s1 != s2 and right_corner(seg, s1, s2):
+                    pairs.add((s1, s2))
+    pairs = np.array(sorted(pairs), dtype=np.int64).reshape(-1, 2)
+    pstart = np.zeros(ns + 1, dtype=np.int64)
+    np.cumsum(np.bincount(pairs[:, 0], minlength=ns), out=pstart[1:])
+    return pstart, np.ascontiguousarray(pairs[:, 1])
+
+
+@njit(inline="always", cache=True)
+def _in_sorted(a, lo, hi, v):
+    """True if v is among a[lo:hi], which is sorted (bisection)."""
+    end = hi
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if a[mid] < v:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo < end and a[lo] == v
+
+
 @njit(parallel=True, cache=True)
-def _corner_scan(wstart, wseg, seg, cstart, cpair, fill):
+def _corner_scan(wstart, wseg, pstart, partner, cstart, cpair, fill):
     """Count (fill False: into cstart[i + 1]) or list (fill True) each particle's corners.
 
-    A corner is a pair of i's near segments that meet at a right angle
-    (:func:`right_corner`); listing them once per neighbour-list build spares the kernels a
-    search over all pairs for every neighbour. At other angles the double image of a point
-    (a rotation by twice the angle between the walls) can fall in the water, so those corners
-    get the single images only.
+    A corner is a pair of i's near segments that meet at a right angle: the partners
+    (:func:`_corner_partners`) of each near segment looked up among the later ones of i's
+    sorted run. Listing them once per neighbour-list build spares the kernels a search over
+    all pairs for every neighbour. At other angles the double image of a point (a rotation by
+    twice the angle between the walls) can fall in the water, so those corners get the single
+    images only.
     """
     for i in prange(wstart.shape[0] - 1):
         k = 0
-        for w in range(wstart[i], wstart[i + 1]):
-            for w2 in range(w + 1, wstart[i + 1]):
-                if right_corner(seg, wseg[w], wseg[w2]):
+        end = wstart[i + 1]
+        for w in range(wstart[i], end):
+            s = wseg[w]
+            for q in range(pstart[s], pstart[s + 1]):
+                if _in_sorted(wseg, w + 1, end, partner[q]):
                     if fill:
-                        cpair[cstart[i] + k, 0] = wseg[w]
-                        cpair[cstart[i] + k, 1] = wseg[w2]
+                        cpair[cstart[i] + k, 0] = s
+                        cpair[cstart[i] + k, 1] = partner[q]
                     k += 1
         if not fill:
             cstart[i + 1] = k
@@ -316,26 +395,43 @@ def hides(ax, ay, bx, by, seg, s):
                    seg[s, 3])
 
 
-@njit(inline="always", cache=True)
-def blocked(xi, yi, xj, yj, wstart, wseg, seg, i):
-    """True if a wall near particle i separates it from the point (xj, yj) (:func:`hides`)."""
-    for k in range(wstart[i], wstart[i + 1]):
-        if hides(xi, yi, xj, yj, seg, wseg[k]):
-            return True
-    return False
+SIGHT_SLACK = 1e-6
+"""Slack [m] of the distance tests that skip far segments: a segment that :func:`hides` a
+point at distance r from particle i lies within r + |TIE_SHIFT| (1e-7 m) of i, so one
+farther than r + SIGHT_SLACK neither blocks the pair nor makes an image within r (the margin
+also covers rounding, ~1e-10 m at 1e5 m from the origin)."""
 
 
 @njit(parallel=True, cache=True)
-def blocked_pairs(x, y, nstart, nbr, wstart, wseg, seg, out):
+def blocked_pairs(x, y, nstart, nbr, wstart, wseg, seg, out, wdist):
     """out[q] = True when a wall near particle i separates it from its neighbour nbr[q].
 
-    Computed once per step (positions fixed) for the density iterations and the forces,
-    which then skip such pairs and their mirror images at the cost of a lookup.
+    Also ``wdist[k]``, the distance [m] from particle i to its near segment wseg[k]: a segment
+    farther from i than r_ij + SIGHT_SLACK cannot hide j (:func:`hides`), and the density
+    summation and the forces skip the images of segments beyond their support the same way.
+    Computed once per step (positions fixed) for the density iterations and the forces, which
+    then skip blocked pairs and their mirror images at the cost of a lookup.
     """
     for i in prange(x.shape[0]):
-        near = wstart[i + 1] > wstart[i]
+        xi = x[i]
+        yi = y[i]
+        nearest = np.inf
+        for k in range(wstart[i], wstart[i + 1]):
+            s = wseg[k]
+            wdist[k] = segment_distance(xi, yi, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+            nearest = min(nearest, wdist[k])
         for q in range(nstart[i], nstart[i + 1]):
-            out[q] = near and blocked(x[i], y[i], x[nbr[q]], y[nbr[q]], wstart, wseg, seg, i)
+            j = nbr[q]
+            reach = math.hypot(xi - x[j], yi - y[j]) + SIGHT_SLACK
+            hit = False
+            if reach < nearest:  # no segment is that close: none can hide j
+                out[q] = False
+                continue
+            for k in range(wstart[i], wstart[i + 1]):
+                if wdist[k] <= reach and hides(xi, yi, x[j], y[j], seg, wseg[k]):
+                    hit = True
+                    break
+            out[q] = hit
 
 
 @njit(inline="always", cache=True)
