@@ -226,7 +226,7 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, xmin, ymi
                 and radius < clear[int(cy) * lv_nbx[0] + int(cx)]):
             continue
         lv = 0
-        while lv < top and lv_bucket[lv] < radius:
+        while lv < top and lv_bucket[lv] < 0.5 * radius:
             lv += 1
         bucket = lv_bucket[lv]
         nbx = lv_nbx[lv]
@@ -420,11 +420,16 @@ def blocked_pairs(x, y, nstart, nbr, wstart, wseg, seg, out, wdist):
             s = wseg[k]
             wdist[k] = segment_distance(xi, yi, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
             nearest = min(nearest, wdist[k])
+        if wstart[i + 1] == wstart[i]:
+            out[nstart[i]:nstart[i + 1]] = False
+            continue
         for q in range(nstart[i], nstart[i + 1]):
             j = nbr[q]
-            reach = math.hypot(xi - x[j], yi - y[j]) + SIGHT_SLACK
+            rx = xi - x[j]
+            ry = yi - y[j]
             hit = False
-            if reach < nearest:  # no segment is that close: none can hide j
+            reach = math.sqrt(rx * rx + ry * ry) + SIGHT_SLACK
+            if reach < nearest:  # no segment is that close: none hides j
                 out[q] = False
                 continue
             for k in range(wstart[i], wstart[i + 1]):
