@@ -64,9 +64,9 @@ class WallIndex:
     Level L is a grid of square buckets of side ``bucket * 2**L``, up to one bucket over the
     domain; each bucket lists the segments whose bounding box overlaps it (buckets beyond the
     domain's bounds are clamped to the outermost ones). A query of radius R walks the finest
-    level whose buckets are at least R wide (at most 3 x 3 buckets, however large R: a lone
-    thin particle's smoothing length can be ten times the others', and every neighbour of it
-    queries that far). It takes each segment in the first of its buckets that the segment and
+    level whose buckets are at least R / 2 wide (at most 5 x 5 buckets, however large R: a
+    lone thin particle's smoothing length can be ten times the others', and every neighbour of
+    it queries that far). It takes each segment in the first of its buckets that the segment and
     the query square share (:func:`query_box`, :func:`first_visit`), so no segment is seen
     twice and the cost follows the walls near the point, not their total.
 
