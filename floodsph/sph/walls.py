@@ -211,7 +211,7 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, xmin, ymi
     """Count (into ``count[i]``) and list (into ``rows[i]``, in index order, as far as the row
     is wide) each particle's segments within reach * max(h_i, max_j h_j); a particle inside
     the level-0 grid whose radius is below its bucket's ``clear`` distance has none. The
-    buckets walked are those of the finest level at least as wide as the radius."""
+    buckets walked are those of the finest level at least half as wide as the radius."""
     width = rows.shape[1]
     top = lv_bucket.shape[0] - 1
     for i in prange(x.shape[0]):
@@ -427,15 +427,13 @@ def blocked_pairs(x, y, nstart, nbr, wstart, wseg, seg, out, wdist):
             j = nbr[q]
             rx = xi - x[j]
             ry = yi - y[j]
-            hit = False
             reach = math.sqrt(rx * rx + ry * ry) + SIGHT_SLACK
-            if reach < nearest:  # no segment is that close: none hides j
-                out[q] = False
-                continue
-            for k in range(wstart[i], wstart[i + 1]):
-                if wdist[k] <= reach and hides(xi, yi, x[j], y[j], seg, wseg[k]):
-                    hit = True
-                    break
+            hit = False
+            if reach >= nearest:  # else no segment is that close, and none hides j
+                for k in range(wstart[i], wstart[i + 1]):
+                    if wdist[k] <= reach and hides(xi, yi, x[j], y[j], seg, wseg[k]):
+                        hit = True
+                        break
             out[q] = hit
 
 
