@@ -74,3 +74,29 @@ def test_resampled_grid_is_aligned_to_the_dem_origin():
     X, Y = np.meshgrid(xc + 100, yc + 200)
     inner = (X < 129.5) & (Y < 220.5)
     np.testing.assert_allclose(grid.bed[inner], (0.5 * X + 2.0 * Y)[inner])
+
+
+def test_kernel_sums_equal_a_brute_force_sum_with_h_spread_over_many_levels():
+    """A fifth of the particles thin out to h up to ten times the rest (the share at which a
+    split into two groups used to fall back to one grid of the largest h): every point gets
+    the sum over all particles whose support reaches it."""
+    rng = np.random.default_rng(11)
+    n = 2000
+    x, y = rng.uniform(0.0, 500.0, n), rng.uniform(0.0, 300.0, n)
+    h = np.full(n, 6.5)
+    thin = rng.random(n) < 0.2
+    h[thin] *= rng.uniform(1.0, 10.0, thin.sum())
+    rho = RHO_WATER * rng.uniform(0.05, 2.0, n)
+    m = rho * 25.0
+    u, v = rng.normal(0.0, 1.0, n), rng.normal(0.0, 1.0, n)
+    px, py = rng.uniform(-50.0, 550.0, 3000), rng.uniform(-50.0, 350.0, 3000)
+    d, uu, _, support = interpolate(px, py, x, y, u, v, m, rho, h, min_support=0.0)
+    r = np.hypot(px[:, None] - x, py[:, None] - y)
+    w = np.where(r < 2.0 * h, m / rho * np.vectorize(w_cubic)(r, h), 0.0)
+    np.testing.assert_allclose(support, w.sum(axis=1), rtol=1e-12, atol=1e-15)
+    reached = support > 0.0
+    assert reached.mean() > 0.9
+    np.testing.assert_allclose(d[reached], (w @ (rho / RHO_WATER))[reached] / support[reached],
+                               rtol=1e-10)
+    np.testing.assert_allclose(uu[reached], (w @ u)[reached] / support[reached], rtol=1e-9,
+                               atol=1e-12)

@@ -22,10 +22,13 @@ not mapped: it carries a negligible volume.
 
 The loop gathers over the target points (iteration k writes only the sums of point k), so it
 is race-free under ``prange``. Particles are binned with
-:class:`floodsph.sph.neighbours.CellGrid` in two groups, so that a few particles with a huge
-h do not inflate the cell size for all: ordinary particles (h <= h_cut, h_cut = min(h_max,
-2 mean h)) in cells of 2 h_cut, the rest in cells of 2 max(h); each group is searched in the
-3 x 3 cells around the point, which holds every particle whose support reaches it.
+:class:`floodsph.sph.neighbours.CellGrid` by the levels of h of the neighbour search
+(:func:`floodsph.sph.neighbours.h_levels`: level 0 up to 1.25 median h, then factors of
+2), each level in cells of twice its largest h, so that particles with a large h do not
+inflate the cell size for all; each level is searched in the 3 x 3 cells around the point,
+which hold every particle of it whose support reaches the point. (Two groups, split at twice
+the mean h and merged into one when more than 5 % were above it, made a Malpasset map update
+take 169 ms late in the run, with 8 % of the particles above and h up to ten times h0.)
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ from scipy import ndimage
 
 from floodsph.constants import RHO_WATER
 from floodsph.sph.kernels import w_cubic
-from floodsph.sph.neighbours import CellGrid
+from floodsph.sph.neighbours import LEVEL_BASE, CellGrid, h_levels
 
 MIN_SUPPORT = 0.5
 """Default minimum kernel sum S = sum_j V_j W for a point to be mapped (see module doc)."""
@@ -92,17 +95,12 @@ def kernel_sums(px, py, x, y, u, v, m, rho, h) -> np.ndarray:
         return sums
     vol = m / rho
     d = rho / RHO_WATER
-    h_max = float(h.max())
-    h_cut = min(h_max, 2.0 * float(h.mean()))
-    big = h > h_cut
-    if big.sum() > 0.05 * h.shape[0]:
-        big[:] = False
-    for group in (~big, big):
-        if not group.any():
-            continue
+    level = np.empty(x.shape[0], dtype=np.int64)
+    lv_hmax, box = h_levels(x, y, h, LEVEL_BASE * float(np.median(h)), level)
+    for lv in np.flatnonzero(lv_hmax > 0.0):
+        group = level == lv
         gx, gy, gh = x[group], y[group], h[group]
-        bounds = (gx.min(), gy.min(), gx.max(), gy.max())
-        grid = CellGrid(gx, gy, 2.0 * float(gh.max()), bounds)
+        grid = CellGrid(gx, gy, 2.0 * float(lv_hmax[lv]), tuple(box[lv]))
         k = np.flatnonzero(_reached(px, py, grid))
         part = np.zeros((k.size, 4), dtype=np.float64)
         accumulate_sums(px[k], py[k], gx, gy, gh, vol[group], d[group], u[group], v[group],

@@ -97,8 +97,9 @@ class CellGrid:
 
 
 @njit(cache=True)
-def _levels(x, y, h, h_c, level):
-    """Search level of every particle into ``level``.
+def h_levels(x, y, h, h_c, level):
+    """Search level of every particle into ``level``: 0 for h <= h_c, L >= 1 for h in
+    (h_c 2^(L-1), h_c 2^L].
 
     Returns (hmax, box): the largest h of each level and its particles' bounding box
     (x0, y0, x1, y1); an empty level has hmax 0.
@@ -256,7 +257,7 @@ class NeighbourList:
             self.nbr = np.zeros(0, dtype=np.int64)
             return
         level = np.empty(n, dtype=np.int64)
-        lv_hmax, box = _levels(x, y, h, LEVEL_BASE * float(np.median(h)), level)
+        lv_hmax, box = h_levels(x, y, h, LEVEL_BASE * float(np.median(h)), level)
         used = lv_hmax > 0.0
         width = np.where(used, box[:, 2] - box[:, 0], 0.0)
         height = np.where(used, box[:, 3] - box[:, 1], 0.0)
