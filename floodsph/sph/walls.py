@@ -320,37 +320,26 @@ def _corner_partners(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pstart, np.ascontiguousarray(pairs[:, 1])
 
 
-@njit(inline="always", cache=True)
-def _in_sorted(a, lo, hi, v):
-    """True if v is among a[lo:hi], which is sorted (bisection)."""
-    end = hi
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if a[mid] < v:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo < end and a[lo] == v
-
-
 @njit(parallel=True, cache=True)
 def _corner_scan(wstart, wseg, pstart, partner, cstart, cpair, fill):
     """Count (fill False: into cstart[i + 1]) or list (fill True) each particle's corners.
 
     A corner is a pair of i's near segments that meet at a right angle: the partners
-    (:func:`_corner_partners`) of each near segment looked up among the later ones of i's
-    sorted run. Listing them once per neighbour-list build spares the kernels a search over
-    all pairs for every neighbour. At other angles the double image of a point (a rotation by
-    twice the angle between the walls) can fall in the water, so those corners get the single
-    images only.
+    (:func:`_corner_partners`) of each near segment looked up (``np.searchsorted``) among
+    the later ones of i's sorted run. Listing them once per neighbour-list build spares the
+    kernels a search over all pairs for every neighbour. At other angles the double image of
+    a point (a rotation by twice the angle between the walls) can fall in the water, so those
+    corners get the single images only.
     """
     for i in prange(wstart.shape[0] - 1):
         k = 0
         end = wstart[i + 1]
         for w in range(wstart[i], end):
             s = wseg[w]
+            later = wseg[w + 1:end]
             for q in range(pstart[s], pstart[s + 1]):
-                if _in_sorted(wseg, w + 1, end, partner[q]):
+                at = np.searchsorted(later, partner[q])
+                if at < later.shape[0] and later[at] == partner[q]:
                     if fill:
                         cpair[cstart[i] + k, 0] = s
                         cpair[cstart[i] + k, 1] = partner[q]
