@@ -100,3 +100,33 @@ def test_kernel_sums_equal_a_brute_force_sum_with_h_spread_over_many_levels():
                                rtol=1e-10)
     np.testing.assert_allclose(uu[reached], (w @ u)[reached] / support[reached], rtol=1e-9,
                                atol=1e-12)
+
+
+def test_map_grid_sums_equal_a_brute_force_sum_over_every_cell():
+    """The scatter over row bands (``rasterise``) gives every cell the sum over all particles
+    whose support reaches its centre, and the cells no particle reaches are NaN: particles
+    with h from one to ten times the rest, some beyond the grid's edges and some whose
+    support spans many bands."""
+    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, 600), (0, 450), 10.0)
+    grid = OutputGrid.from_terrain(terrain)
+    rng = np.random.default_rng(5)
+    n = 1500
+    x, y = rng.uniform(-80.0, 380.0, n), rng.uniform(-80.0, 530.0, n)
+    h = 6.5 * np.where(rng.random(n) < 0.2, rng.uniform(1.0, 10.0, n), 1.0)
+    rho = RHO_WATER * rng.uniform(0.05, 2.0, n)
+    u, v = rng.normal(0.0, 1.0, n), rng.normal(0.0, 1.0, n)
+    d, uu, vv, support = rasterise(grid, x, y, u, v, rho * 25.0, rho, h, min_support=0.0)
+    assert d.shape == support.shape == grid.shape
+    xc, yc = grid.cell_centres()
+    px, py = (a.ravel() for a in np.meshgrid(xc, yc))
+    r = np.hypot(px[:, None] - x, py[:, None] - y)
+    w = np.where(r < 2.0 * h, 25.0 * np.vectorize(w_cubic)(r, h), 0.0)
+    s = w.sum(axis=1)
+    np.testing.assert_allclose(support.ravel(), s, rtol=1e-12, atol=1e-15)
+    reached = s > 0.0
+    assert 0.5 < reached.mean() < 1.0
+    np.testing.assert_allclose(d.ravel()[reached], (w @ (rho / RHO_WATER))[reached] / s[reached],
+                               rtol=1e-10)
+    np.testing.assert_allclose(vv.ravel()[reached], (w @ v)[reached] / s[reached], rtol=1e-9,
+                               atol=1e-12)
+    assert np.all(np.isnan(d.ravel()[~reached]))

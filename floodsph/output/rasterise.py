@@ -29,12 +29,21 @@ inflate the cell size for all; each level is searched in the 3 x 3 cells around 
 which hold every particle of it whose support reaches the point. (Two groups, split at twice
 the mean h and merged into one when more than 5 % were above it, made a Malpasset map update
 take 169 ms late in the run, with 8 % of the particles above and h up to ten times h0.)
+
+A map grid is a regular lattice, so :func:`rasterise` scatters instead (:func:`grid_sums`):
+each particle visits only the cells of the box around its support, about 4 / pi times the
+cells it reaches, where the gather over 3 x 3 bins of twice the largest h of a level tests
+three to ten times as many pairs. The rows are cut into bands of ``BAND_ROWS``; a particle is
+listed in every band its support reaches, and each band is summed by one thread, which
+writes only that band's rows, so the scatter is race-free. (On EA test 4 at 10 m, where the
+envelopes are updated at nearly every step, the gather took two thirds of the run.)
 """
 
 from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from numba import njit, prange
 from scipy import ndimage
@@ -45,6 +54,8 @@ from floodsph.sph.neighbours import LEVEL_BASE, CellGrid, h_levels
 
 MIN_SUPPORT = 0.5
 """Default minimum kernel sum S = sum_j V_j W for a point to be mapped (see module doc)."""
+BAND_ROWS = 4
+"""Map rows per band of :func:`grid_sums` (the unit of work of one thread)."""
 
 
 @njit(parallel=True, cache=True)
@@ -141,10 +152,29 @@ def interpolate(px, py, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT)
     -------
     d, u, v, support : float64 arrays shaped like ``px``; NaN where unsupported.
     """
-    shape = np.shape(px)
     sums = kernel_sums(np.ravel(px), np.ravel(py), x, y, u, v, m, rho, h)
+    return _shepard(sums, min_support, np.shape(px))
+
+
+def rasterise(grid, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT):
+    """Depth d [m] and velocity (u, v) [m/s] on an :class:`OutputGrid` (row 0 = south).
+
+    The values of :func:`interpolate` at the cell centres, summed by :func:`grid_sums`;
+    returns ``(d, u, v, support)``, each ``grid.shape``.
+    """
+    xc, yc = grid.cell_centres()
+    sums = np.zeros((yc.shape[0], xc.shape[0], 4), dtype=np.float64)
+    if x.shape[0]:
+        band_start, band_items = band_lists(yc, y, h, BAND_ROWS)
+        grid_sums(xc, yc, x, y, h, m / rho, rho / RHO_WATER, u, v, band_start, band_items,
+                  BAND_ROWS, numba.get_num_threads(), sums)
+    return _shepard(sums.reshape(-1, 4), min_support, grid.shape)
+
+
+def _shepard(sums, min_support: float, shape):
+    """(d, u, v, support) from kernel sums (n, 4): NaN where the support is short (or 0)."""
     support = sums[:, 0]
-    ok = support >= min_support
+    ok = (support >= min_support) & (support > 0.0)
     out = []
     for c in (1, 2, 3):
         f = np.full(support.shape, np.nan)
@@ -153,11 +183,78 @@ def interpolate(px, py, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT)
     return out[0], out[1], out[2], support.reshape(shape)
 
 
-def rasterise(grid, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT):
-    """Depth d [m] and velocity (u, v) [m/s] on an :class:`OutputGrid` (row 0 = south).
+@njit(cache=True)
+def _span(c, reach, first, step, n):
+    """Index range [lo, hi] of the lattice first + k step (k < n) within ``reach`` of c, with a
+    margin of one index (the caller tests the distance); lo > hi if there is none."""
+    lo = max(int(math.floor((c - reach - first) / step)), 0)
+    hi = min(int(math.ceil((c + reach - first) / step)), n - 1)
+    return lo, hi
 
-    See :func:`interpolate`; returns ``(d, u, v, support)``, each ``grid.shape``.
+
+@njit(cache=True)
+def band_lists(yc, y, h, band_rows):
+    """CSR lists (start, items) of the particles whose support 2 h_j reaches each band of
+    ``band_rows`` map rows (row centres ``yc``, evenly spaced)."""
+    ny = yc.shape[0]
+    dy = yc[1] - yc[0] if ny > 1 else 1.0
+    nbands = (ny + band_rows - 1) // band_rows
+    start = np.zeros(nbands + 1, dtype=np.int64)
+    for j in range(y.shape[0]):
+        lo, hi = _span(y[j], 2.0 * h[j], yc[0], dy, ny)
+        if lo > hi:
+            continue
+        for b in range(lo // band_rows, hi // band_rows + 1):
+            start[b + 1] += 1
+    for b in range(nbands):
+        start[b + 1] += start[b]
+    items = np.empty(start[nbands], dtype=np.int64)
+    fill = start[:-1].copy()
+    for j in range(y.shape[0]):
+        lo, hi = _span(y[j], 2.0 * h[j], yc[0], dy, ny)
+        if lo > hi:
+            continue
+        for b in range(lo // band_rows, hi // band_rows + 1):
+            items[fill[b]] = j
+            fill[b] += 1
+    return start, items
+
+
+@njit(parallel=True, cache=True)
+def grid_sums(xc, yc, x, y, h, vol, d, u, v, band_start, band_items, band_rows, chunks, sums):
+    """Add sum_j V_j W(|x_cell - x_j|, h_j) (1, d_j, u_j, v_j) into ``sums[row, col, :]`` for
+    every cell of the lattice (column centres ``xc``, row centres ``yc``, evenly spaced).
+
+    Scatter form, race-free: chunk c (of ``chunks``, one per thread) sums the bands
+    b = c, c + chunks, ... (interleaved, which balances a flood covering a few bands), and
+    a band writes only its own rows; within a band the particles of ``band_lists`` add in
+    index order, so the result does not depend on the number of threads.
     """
-    xc, yc = grid.cell_centres()
-    px, py = np.meshgrid(xc, yc)
-    return interpolate(px, py, x, y, u, v, m, rho, h, min_support)
+    nx = xc.shape[0]
+    ny = yc.shape[0]
+    dx = xc[1] - xc[0] if nx > 1 else 1.0
+    dy = yc[1] - yc[0] if ny > 1 else 1.0
+    nbands = band_start.shape[0] - 1
+    for c in prange(chunks):
+        for b in range(c, nbands, chunks):
+            r_first = b * band_rows
+            r_last = min(r_first + band_rows, ny) - 1
+            for s in range(band_start[b], band_start[b + 1]):
+                j = band_items[s]
+                xj = x[j]
+                yj = y[j]
+                hj = h[j]
+                reach = 2.0 * hj
+                lo, hi = _span(yj, reach, yc[0], dy, ny)
+                c_lo, c_hi = _span(xj, reach, xc[0], dx, nx)
+                for r in range(max(lo, r_first), min(hi, r_last) + 1):
+                    ry = yc[r] - yj
+                    for col in range(c_lo, c_hi + 1):
+                        rx = xc[col] - xj
+                        q = math.sqrt(rx * rx + ry * ry)
+                        if q < reach:
+                            w = vol[j] * w_cubic(q, hj)
+                            sums[r, col, 0] += w
+                            sums[r, col, 1] += w * d[j]
+                            sums[r, col, 2] += w * u[j]
+                            sums[r, col, 3] += w * v[j]
