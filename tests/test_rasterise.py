@@ -103,7 +103,7 @@ def test_kernel_sums_equal_a_brute_force_sum_with_h_spread_over_many_levels():
 
 
 def test_map_grid_sums_equal_a_brute_force_sum_over_every_cell():
-    """The scatter over row bands (``rasterise``) gives every cell the sum over all particles
+    """The gather by row bands (``rasterise``) gives every cell the sum over all particles
     whose support reaches its centre, and the cells no particle reaches are NaN: particles
     with h from one to ten times the rest, some beyond the grid's edges and some whose
     support spans many bands."""

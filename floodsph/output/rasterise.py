@@ -30,13 +30,14 @@ which hold every particle of it whose support reaches the point. (Two groups, sp
 the mean h and merged into one when more than 5 % were above it, made a Malpasset map update
 take 169 ms late in the run, with 8 % of the particles above and h up to ten times h0.)
 
-A map grid is a regular lattice, so :func:`rasterise` scatters instead (:func:`grid_sums`):
-each particle visits only the cells of the box around its support, about 4 / pi times the
-cells it reaches, where the gather over 3 x 3 bins of twice the largest h of a level tests
-three to ten times as many pairs. The rows are cut into bands of ``BAND_ROWS``; a particle is
-listed in every band its support reaches, and each band is summed by one thread, which
-writes only that band's rows, so the scatter is race-free. (On EA test 4 at 10 m, where the
-envelopes are updated at nearly every step, the gather took two thirds of the run.)
+A map grid is a regular lattice, so :func:`rasterise` gathers by bands of ``BAND_ROWS`` rows
+instead (:func:`grid_sums`): a particle is listed in every band its support reaches, and
+within a band each listed particle adds to the cells of the box around its support, about
+4 / pi times the cells it reaches, where the point gather over 3 x 3 bins of twice the
+largest h of a level tests three to ten times as many pairs. A band is owned by one
+parallel iteration, which writes only that band's rows, so there are no races. (On EA test 4
+at 10 m, where the envelopes are updated at nearly every step, the point gather took two
+thirds of the run.)
 """
 
 from __future__ import annotations
@@ -225,10 +226,11 @@ def grid_sums(xc, yc, x, y, h, vol, d, u, v, band_start, band_items, band_rows, 
     """Add sum_j V_j W(|x_cell - x_j|, h_j) (1, d_j, u_j, v_j) into ``sums[row, col, :]`` for
     every cell of the lattice (column centres ``xc``, row centres ``yc``, evenly spaced).
 
-    Scatter form, race-free: chunk c (of ``chunks``, one per thread) sums the bands
-    b = c, c + chunks, ... (interleaved, which balances a flood covering a few bands), and
-    a band writes only its own rows; within a band the particles of ``band_lists`` add in
-    index order, so the result does not depend on the number of threads.
+    Gather form over row bands, race-free: parallel iteration c (of ``chunks``, one per
+    thread) owns the bands b = c, c + chunks, ... (interleaved, which balances a flood
+    covering a few bands) and writes only their rows; within a band the particles of
+    ``band_lists`` add to the cells of their support box in index order, so the result does
+    not depend on the number of threads.
     """
     nx = xc.shape[0]
     ny = yc.shape[0]
