@@ -35,6 +35,20 @@ def test_stage_times_are_exclusive_and_add_up_to_the_wall_time():
     assert model.counters["splits"] > 0
 
 
+def test_map_update_timing_compares_the_band_and_point_gathers_on_the_same_cells():
+    """After a dam break has spread (h from 1.3 to several times that), the two ways of
+    interpolating onto the map grid map the same cells with the same depths."""
+    from floodsph.output.grid import OutputGrid
+
+    model = model_on(lambda x, y: 0 * x, (0, 60), (0, 30), 0.5,
+                     lambda x, y: np.where(x < 15.0, 1.0, 0.0), 1.0)
+    prof.profile(model, steps=30, warmup=0)
+    grid = OutputGrid.from_terrain(model.terrain)
+    out = prof.map_update_times(model, grid, repeats=1)
+    assert out["cells"] == grid.nx * grid.ny and out["particles"] == model.particles.n
+    assert out["wet_mask_equal"] and out["max_depth_diff_m"] < 1e-12
+
+
 def test_a_bad_scenario_path_is_one_clear_error(tmp_path, capsys):
     missing = tmp_path / "nope.toml"
     assert prof.main([str(missing), "--steps", "1"]) == 2

@@ -8,8 +8,13 @@ The rest of the step (drift, boundaries, friction, time step) is ``other``. Prin
 table and the neighbour-list builds per step. The first steps compile the numba kernels when
 they are not cached yet: ``--warmup`` steps (default 3) run before the clock starts.
 
+The stages leave out the run's recorders. ``--maps N`` then also times one update of the map
+envelopes' interpolation at the final state on the scenario's map grid, best of N: the band
+gather the run uses (``floodsph.output.rasterise.rasterise``) and the point gather of
+``interpolate`` at every cell centre, with the largest depth difference between the two.
+
     python workflows/profile_stages.py SCENARIO.toml [--steps 500 | --end-time 600]
-        [--threads 2] [--warmup 3]
+        [--threads 2] [--warmup 3] [--maps 5]
 """
 
 from __future__ import annotations
@@ -89,6 +94,35 @@ def profile(model, steps: int | None = None, end_time: float | None = None,
     return rows, totals
 
 
+def map_update_times(model, grid, repeats: int = 3) -> dict:
+    """Best-of-``repeats`` wall time [ms] of one interpolation of the model's particles onto
+    ``grid`` (an ``OutputGrid``): by row bands (``band_ms``, what the envelopes use) and by
+    points at the cell centres (``points_ms``); ``max_depth_diff_m`` is the largest depth
+    difference between the two, and ``wet_mask_equal`` whether the same cells are mapped."""
+    import numpy as np
+
+    from floodsph.output.rasterise import interpolate, rasterise
+
+    p = model.particles
+    fields = (p.x, p.y, p.u, p.v, p.m, p.rho, p.h)
+    xc, yc = grid.cell_centres()
+    px, py = np.meshgrid(xc, yc)
+    best = {"band_ms": np.inf, "points_ms": np.inf}
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        band = rasterise(grid, *fields)[0]
+        t1 = time.perf_counter()
+        points = interpolate(px, py, *fields)[0]
+        t2 = time.perf_counter()
+        best["band_ms"] = min(best["band_ms"], 1e3 * (t1 - t0))
+        best["points_ms"] = min(best["points_ms"], 1e3 * (t2 - t1))
+    mapped = ~np.isnan(band)
+    diff = np.abs(band[mapped] - points[mapped])
+    return best | {"cells": band.size, "particles": p.n,
+                   "max_depth_diff_m": float(diff.max()) if diff.size else 0.0,
+                   "wet_mask_equal": bool(np.array_equal(mapped, ~np.isnan(points)))}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scenario", type=Path)
@@ -96,6 +130,8 @@ def main(argv=None) -> int:
     ap.add_argument("--end-time", type=float, default=None, help="or run up to this time [s]")
     ap.add_argument("--threads", type=int, default=0, help="numba threads (0 = all cores)")
     ap.add_argument("--warmup", type=int, default=3, help="untimed steps first")
+    ap.add_argument("--maps", type=int, default=0, metavar="N",
+                    help="also time a map update at the end, best of N")
     args = ap.parse_args(argv)
     from floodsph.errors import InputError
     from floodsph.inputs import prepare_inputs
@@ -105,7 +141,8 @@ def main(argv=None) -> int:
     set_threads(args.threads)
     try:
         scenario = load_scenario(args.scenario)
-        model = build_model(scenario, prepare_inputs(scenario))
+        inputs = prepare_inputs(scenario)
+        model = build_model(scenario, inputs)
     except InputError as exc:
         print(f"Error: {exc}", file=sys.stderr)
         return 2
@@ -114,6 +151,12 @@ def main(argv=None) -> int:
     print(markdown(rows, spec=".3g"))
     print()
     print(markdown([totals], spec=".4g"))
+    if args.maps > 0:
+        from floodsph.output.grid import OutputGrid
+
+        grid = OutputGrid.from_terrain(inputs.terrain, scenario.output.resolution_m)
+        print()
+        print(markdown([map_update_times(model, grid, args.maps)], spec=".4g"))
     return 0
 
 
