@@ -11,10 +11,15 @@ method notes 2.6-2.7):
 4. forces a^{n+1} at (x^{n+1}, v^{n+1/2}): pressure + shock capturing + bed
 5. kick   v^{n+1} = v^{n+1/2} + a^{n+1} dt / 2, then semi-implicit Manning friction over dt
 6. next dt = cfl min h / (|v| + c)
+
+With ``Numerics.time_stepping = "local"`` a call to :meth:`FloodModel.step` takes one big step
+of 2^K such steps, in which each particle does steps 1-5 at its own power-of-two multiple of
+the finest step (``floodsph.sph.local_steps``).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,13 +31,15 @@ from floodsph.boundaries.openings import cut_openings
 from floodsph.constants import RHO_WATER
 from floodsph.particles import ParticleSet
 from floodsph.sph import bed as bedmod
-from floodsph.sph import density, forces
+from floodsph.sph import density, forces, local_steps
 from floodsph.sph import walls as wallmod
 from floodsph.sph.neighbours import CellGrid, NeighbourList
 from floodsph.terrain import Terrain
 
 MAX_SEARCH_GROWTH = 2.0
 """Cap on the factor ``hgrow`` by which a particle's neighbour search is widened."""
+TIME_STEPPING = ("global", "local")
+"""Values of ``Numerics.time_stepping``."""
 SETTLE_ROUNDS = 30
 """Rounds of list building and density solve when the model is set up (h may grow 10-fold)."""
 
@@ -53,6 +60,9 @@ class Numerics:
     neighbour_skin : relative margin of the neighbour lists.
     reorder_interval : steps between spatial re-sorts of the particle arrays.
     refinement : "none" (splitting and coalescing arrive with the refinement module).
+    time_stepping : "global" (one step for all particles) or "local" (each particle at its
+        own power-of-two multiple of the finest step, ``floodsph.sph.local_steps``).
+    step_levels : K of local stepping: a big step holds 2^K finest steps.
     """
 
     cfl: float = 0.3
@@ -67,6 +77,15 @@ class Numerics:
     neighbour_skin: float = 0.1
     reorder_interval: int = 25
     refinement: str = "none"
+    time_stepping: str = "global"
+    step_levels: int = 3
+
+    def __post_init__(self):
+        if self.time_stepping not in TIME_STEPPING:
+            raise ValueError(f"time_stepping: {self.time_stepping!r} is not one of "
+                             f"{list(TIME_STEPPING)}")
+        if self.step_levels < 0:
+            raise ValueError(f"step_levels must be >= 0, got {self.step_levels}")
 
 
 class FloodModel:
@@ -129,7 +148,7 @@ class FloodModel:
         self.volume_out = 0.0
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
                          "wall_reflections": 0, "density_unconverged": 0,
-                         "density_capped": 0, "density_held": 0}
+                         "density_capped": 0, "density_held": 0, "particle_updates": 0}
         self.bed = np.empty((0, 7))
         self.blocked = np.empty(0, dtype=np.bool_)
         self.wdist = np.empty(0)
@@ -167,37 +186,97 @@ class FloodModel:
 
     # -- one step ------------------------------------------------------------------------------
     def step(self, dt_max: float | None = None) -> float:
-        """Advance one time step (at most ``dt_max``); return the step taken [s]."""
-        p = self.particles
+        """Advance one time step (at most ``dt_max``); return the step taken [s].
+
+        With local time stepping the step is a big step of up to 2^K finest steps
+        (:meth:`_step_local`), at the end of which every particle is synchronised.
+        """
         self._nl_fresh = False
         if getattr(self, "nl", None) is None:  # particles were added or removed between steps
             self._neighbours()
+        if self.numerics.time_stepping == "local":
+            return self._step_local(dt_max)
+        p = self.particles
         dt = self.dt if dt_max is None else min(self.dt, dt_max)
         half = 0.5 * dt
         p.u[:] += half * p.ax
         p.v[:] += half * p.ay
+        self._move(dt)
+        self._synchronise()
+        self._interactions()
+        p.u[:] += half * p.ax
+        p.v[:] += half * p.ay
+        forces.apply_friction(p.u, p.v, p.rho, self.bed[: p.n, 6], dt,
+                              self.numerics.friction_depth_floor)
+        self._advance_clock(dt)
+        self.dt = self.stable_dt()
+        return dt
+
+    def _step_local(self, dt_max: float | None) -> float:
+        """One big step of 2^k finest steps dt_f = ``self.dt``, k <= ``step_levels`` (fewer
+        when ``dt_max`` is shorter), each particle at its own stride (module docstring of
+        ``floodsph.sph.local_steps``); a single step of ``dt_max`` if that is below dt_f."""
+        p = self.particles
+        dt_f = self.dt if dt_max is None else min(self.dt, dt_max)
+        levels = self.numerics.step_levels
+        if dt_max is not None:
+            levels = min(levels, int(math.floor(math.log2(dt_max / dt_f) + 1e-12)))
+        n_sub = 2 ** levels
+        stride = np.empty(p.n, dtype=np.int64)
+        local_steps.strides(p.u, p.v, p.rho, p.h, self.numerics.cfl, dt_f, n_sub, stride)
+        local_steps.limit_strides(stride, self.nl.start, self.nl.nbr, p.n, p.stride)
+        zone = np.zeros(p.n, dtype=bool)
+        for boundary in self.boundaries:
+            zone |= boundary.protected(p.x, p.y)
+        p.stride[zone] = 1
+        half = 0.5 * dt_f
+        for sub in range(n_sub):
+            self._nl_fresh = False
+            begin, _ = local_steps.substep_rows(p.stride, sub)
+            local_steps.kick(begin, p.stride, half, p.u, p.v, p.ax, p.ay)
+            self._move(dt_f)
+            p.stride[p.stride == 0] = 1  # water that entered in this substep: finest stride
+            last = sub == n_sub - 1
+            if last:
+                self._synchronise(n_sub)  # new particles inherit their parents' strides
+            end = None if last else local_steps.substep_rows(p.stride, sub)[1]
+            self._interactions(rows=end)
+            end = np.arange(p.n, dtype=np.int64) if end is None else end
+            local_steps.close_steps(end, p.stride, dt_f, p.u, p.v, p.ax, p.ay, p.rho,
+                                    self.bed[:, 6], self.numerics.friction_depth_floor)
+            self._advance_clock(dt_f, end.size)
+        self.dt = self.stable_dt()
+        return n_sub * dt_f
+
+    def _move(self, dt: float) -> None:
+        """Drift every particle by dt (walls reflect), let the open boundaries act, drop what
+        left the domain, and advance density and h by the continuity guess."""
+        p = self.particles
         self.counters["wall_reflections"] += int(wallmod.drift(
             p.x, p.y, p.u, p.v, dt, *self.walls_near[:2], self.seg))
         for boundary in self.boundaries:
             boundary.apply(self, dt)
         self._remove_outside(nodata=self.closed_edges is False)
         density.predict(p.rho, p.h, p.divv, dt)
+
+    def _synchronise(self, steps_taken: int = 1) -> None:
+        """Refinement, and the periodic re-sort, on synchronised particles; ``steps_taken``
+        finest steps end here (the re-sort is due when they cross a multiple of its interval)."""
         if self.refiner is not None:
             splits, merges = self.refiner.apply(self)
             self.counters["splits"] += splits
             self.counters["merges"] += merges
-        if self.numerics.reorder_interval and self.steps % self.numerics.reorder_interval == 0:
+        every = self.numerics.reorder_interval
+        if every and self.steps // every != (self.steps - steps_taken) // every:
             self._reorder()
-        self._interactions()
-        p.u[:] += half * p.ax
-        p.v[:] += half * p.ay
-        forces.apply_friction(p.u, p.v, p.rho, self.bed[: p.n, 6], dt,
-                              self.numerics.friction_depth_floor)
+
+    def _advance_clock(self, dt: float, updated: int | None = None) -> None:
+        """t += dt, one more finest step, and the counters of particles and updates."""
+        p = self.particles
         self.t += dt
         self.steps += 1
         self.counters["particles_max"] = max(self.counters["particles_max"], p.n)
-        self.dt = self.stable_dt()
-        return dt
+        self.counters["particle_updates"] += p.n if updated is None else updated
 
     def protected(self, x, y, h) -> np.ndarray:
         """True for points (x, y) [m] with a wall segment within the kernel reach of h [m]
@@ -212,18 +291,23 @@ class FloodModel:
         return mask
 
     # -- stages --------------------------------------------------------------------------------
-    def _interactions(self, settle: bool = False) -> None:
+    def _interactions(self, settle: bool = False, rows: np.ndarray | None = None) -> None:
         """Neighbours, density and forces of the water, with the boundaries' ghosts present.
 
         The ghosts (inflow buffers, mirror images beyond open edges) are appended behind the
         water, given the boundary state after the density solve, and dropped after the forces.
-        ``settle`` is for the set-up (:meth:`_solve_density`).
+        ``settle`` is for the set-up (:meth:`_solve_density`). ``rows``: update only these
+        water particles (and the ghosts), with lists built for them alone (local stepping).
         """
         p = self.particles
         water = p.mark()
         for boundary in self.boundaries:
             boundary.add_ghosts(self)
-        self._neighbours()
+        if rows is None:
+            self._neighbours()
+        else:
+            ghosts = np.arange(water[0], p.n, dtype=np.int64)
+            self._neighbours(force=True, rows=np.concatenate([rows, ghosts]))
         self._solve_density(settle)
         for boundary in self.boundaries:
             boundary.impose(self)
@@ -266,13 +350,14 @@ class FloodModel:
             p.permute(grid.order)
             self.nl = None
 
-    def _neighbours(self, force: bool = False) -> None:
+    def _neighbours(self, force: bool = False, rows: np.ndarray | None = None) -> None:
         """Neighbour and near-wall lists, rebuilt when the Verlet skin is used up (or ``force``).
 
         The lists are built for h_i times the growth of h_i in the last density solve
         (``hgrow``, at most ``MAX_SEARCH_GROWTH``), so that a particle whose h keeps growing
         in the solves (a thinning edge) is not held back by its lists step after step
-        (:meth:`_solve_density`).
+        (:meth:`_solve_density`). ``rows``: list only these particles' neighbours (the
+        near-wall lists still cover every particle, for the drift).
         """
         p = self.particles
         nl = getattr(self, "nl", None)
@@ -280,7 +365,8 @@ class FloodModel:
             return
         self._nl_fresh = True
         h_search = p.h * np.clip(p.hgrow, 1.0, MAX_SEARCH_GROWTH)
-        self.nl = NeighbourList(p.x, p.y, h_search, skin=self.numerics.neighbour_skin)
+        self.nl = NeighbourList(p.x, p.y, h_search, skin=self.numerics.neighbour_skin,
+                                rows=rows)
         self.walls_near = self.wall_index.near_lists(p.x, p.y, h_search, self.nl.start,
                                                      self.nl.nbr, self.nl.reach)
 
@@ -293,8 +379,8 @@ class FloodModel:
             self.blocked = np.empty(self.nl.nbr.shape[0], dtype=np.bool_)
         if self.wdist.shape[0] != self.walls_near[1].shape[0]:
             self.wdist = np.empty(self.walls_near[1].shape[0])
-        wallmod.blocked_pairs(p.x, p.y, self.nl.start, self.nl.nbr, *self.walls_near[:2],
-                              self.seg, self.blocked, self.wdist)
+        wallmod.blocked_pairs(self.nl.rows, p.x, p.y, self.nl.start, self.nl.nbr,
+                              *self.walls_near[:2], self.seg, self.blocked, self.wdist)
 
     def _solve_density(self, settle: bool = False) -> None:
         """The depth-density solve.
@@ -320,8 +406,9 @@ class FloodModel:
                 break
             if not settle and (capped == 0 or self._nl_fresh):
                 break
-            self._neighbours(force=True)
-        p.hgrow[:] = p.h / h_predicted
+            self._neighbours(force=True, rows=None if self.nl.complete else self.nl.rows)
+        rows = self.nl.rows
+        p.hgrow[rows] = p.h[rows] / h_predicted[rows]
         self.counters["density_unconverged"] += bad
         self.counters["density_capped"] += capped
         self.counters["density_held"] += held
@@ -331,13 +418,15 @@ class FloodModel:
         t = self.terrain
         if self.bed.shape[0] != p.n:
             self.bed = np.empty((p.n, 7))
-        bedmod.sample_bed(p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
+        rows = self.nl.rows
+        bedmod.sample_bed(rows, p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
             self._blocked_pairs()
-        forces.internal_acceleration(p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, self.nl.start,
-                                     self.nl.nbr, self.blocked, self.wdist, *self.walls_near,
-                                     self.seg, self.scheme, p.ax, p.ay, p.divv)
-        forces.add_bed_acceleration(p.u, p.v, self.bed, self.numerics.max_slope, p.ax, p.ay)
+        forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
+                                     self.nl.start, self.nl.nbr, self.blocked, self.wdist,
+                                     *self.walls_near, self.seg, self.scheme, p.ax, p.ay, p.divv)
+        forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
+                                    p.ay)
 
 
 def _side_segments(terrain: Terrain, closed, extension: float) -> np.ndarray:

@@ -30,6 +30,7 @@ FIELDS: dict[str, tuple[type, str]] = {
     "hgrow": (np.float64, "h after / h before the last density solve (widens the next search)"),
     "level": (np.int64, "refinement level: number of splits in the particle's ancestry"),
     "born": (np.int64, "step at which the particle was created (split, merge or inflow)"),
+    "stride": (np.int64, "local time stepping: own step in finest steps (0: not yet set)"),
     "pid": (np.int64, "unique particle id, never reused"),
 }
 
@@ -78,8 +79,8 @@ class ParticleSet:
         """Append particles; ``x, y, m, rho, h`` are required, the rest default sensibly.
 
         ``u, v`` default to 0, ``h0``/``rho0`` to the given ``h``/``rho``, ``alpha`` to
-        2 rho (its lattice value), ``hgrow`` to 1, ``level`` to 0, ``born`` to 0. New ids are
-        assigned.
+        2 rho (its lattice value), ``hgrow`` to 1, ``level``, ``born`` and ``stride`` to 0.
+        New ids are assigned.
         Returns the slice of the new particles.
         """
         unknown = set(fields) - set(FIELDS)
@@ -98,6 +99,7 @@ class ParticleSet:
             "hgrow": 1.0,
             "level": 0,
             "born": 0,
+            "stride": 0,
         }
         start = self.n
         self._reserve(start + count)

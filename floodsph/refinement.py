@@ -136,6 +136,8 @@ class Refiner:
         self.spacing = float(spacing)
         self.area_max = settings.area_max * self.spacing**2
         self.area_min = settings.area_min * self.spacing**2
+        self._last_call = -1  # model.steps at the last apply: merges are due every
+        # merge_interval steps, also when a call ends several steps (local time stepping)
 
     @classmethod
     def from_settings(cls, mode: str, spacing: float, **overrides) -> Refiner | None:
@@ -151,15 +153,20 @@ class Refiner:
 
         Called by ``FloodModel.step`` after the drift and the density prediction; the step
         then rebuilds the neighbour lists and solves density and h for all particles. Every
-        call first relaxes over-smoothed particles (:func:`relax_smoothing`).
+        call first relaxes over-smoothed particles (:func:`relax_smoothing`), by the
+        compounded rate of the steps since the last call (several with local time stepping).
         """
         s = self.settings
+        steps = model.steps - self._last_call
+        merge_due = model.steps // s.merge_interval != self._last_call // s.merge_interval
+        self._last_call = model.steps
         if not s.splits or model.particles.n == 0:
             return 0, 0
-        relax_smoothing(model.particles, model.numerics.kappa)
+        rate = RELAX_RATE if steps == 1 else 1.0 - (1.0 - RELAX_RATE) ** steps
+        relax_smoothing(model.particles, model.numerics.kappa, rate)
         parents = self.split_candidates(model)
         a = b = np.zeros(0, dtype=np.int64)
-        if s.coalesces and model.steps % s.merge_interval == 0:
+        if s.coalesces and merge_due:
             a, b = self.merge_pairs(model)
         if parents.size == 0 and a.size == 0:
             return 0, 0
@@ -241,7 +248,8 @@ class Refiner:
                                         refine.DAUGHTERS)
         rho = p.rho[rep]
         return dict(x=x, y=y, u=p.u[rep], v=p.v[rep], m=m, rho=rho, h=h, h0=h, rho0=rho,
-                    alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, model.steps))
+                    alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, model.steps),
+                    stride=p.stride[rep])
 
     # -- coalescing --------------------------------------------------------------------------
     def merge_pairs(self, model) -> tuple[np.ndarray, np.ndarray]:
@@ -296,7 +304,8 @@ class Refiner:
         rho, h = out[:, 5], out[:, 6]
         return dict(x=out[:, 0], y=out[:, 1], u=out[:, 2], v=out[:, 3], m=out[:, 4], rho=rho,
                     h=h, h0=h, rho0=rho, alpha=2.0 * rho,
-                    level=np.minimum(p.level[a], p.level[b]), born=np.full(a.size, model.steps))
+                    level=np.minimum(p.level[a], p.level[b]), born=np.full(a.size, model.steps),
+                    stride=np.minimum(p.stride[a], p.stride[b]))
 
 
 def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE) -> None:

@@ -192,6 +192,8 @@ def build_model(scenario: Scenario, inputs):
         friction_depth_floor=num.friction_depth_floor_m,
         max_slope=num.max_slope,
         refinement=num.refinement.value,
+        time_stepping=num.time_stepping.value,
+        step_levels=num.step_levels,
     )
     return FloodModel(
         inputs.terrain,
@@ -288,6 +290,7 @@ def _finish_manifest(manifest: dict, model, probes, wall_time: float) -> None:
         particles_final=len(model.particles),
         splits=int(counters.get("splits", 0)),
         merges=int(counters.get("merges", 0)),
+        particle_updates=int(counters.get("particle_updates", 0)),
         volume_domain_m3=float(model.volume()),
         volume_in_m3=float(model.volume_in),
         volume_out_m3=float(model.volume_out),

@@ -40,6 +40,13 @@ class Refinement(Enum):
     NONE = "none"
 
 
+class TimeStepping(Enum):
+    """One time step for every particle, or each at its own (``floodsph.sph.local_steps``)."""
+
+    GLOBAL = "global"
+    LOCAL = "local"
+
+
 class Stabilisation(Enum):
     """Numerical dissipation of the momentum equation."""
 
@@ -156,6 +163,8 @@ class NumericsConfig:
     ``particle_spacing_m = None`` means the DEM cell size; ``threads = 0`` means all cores.
     ``refine_*`` are the splitting and coalescing thresholds of ``floodsph.refinement``
     (areas in units of particle_spacing_m^2, the split depth floor in m, the generations).
+    ``time_stepping = "local"`` lets each particle step at its own power-of-two multiple of the
+    finest step, up to 2^step_levels of them (``floodsph.sph.local_steps``).
     """
 
     particle_spacing_m: float | None = None
@@ -171,6 +180,8 @@ class NumericsConfig:
     refine_area_min: float = REFINE_DEFAULTS.area_min
     refine_d_min_m: float = REFINE_DEFAULTS.d_min
     refine_max_level: int = REFINE_DEFAULTS.max_level
+    time_stepping: TimeStepping = TimeStepping.GLOBAL
+    step_levels: int = 3
 
 
 @dataclass(frozen=True)
@@ -494,6 +505,8 @@ def _numerics(r: Reader, data: dict) -> NumericsConfig:
         refine_area_min=r.number(t, p, "refine_area_min", d.refine_area_min, gt=0.0),
         refine_d_min_m=r.number(t, p, "refine_d_min_m", d.refine_d_min_m, ge=0.0),
         refine_max_level=r.integer(t, p, "refine_max_level", d.refine_max_level, ge=0),
+        time_stepping=r.choice(t, p, "time_stepping", TimeStepping, d.time_stepping),
+        step_levels=r.integer(t, p, "step_levels", d.step_levels, ge=0, le=6),
     )
     if not out.refine_area_min < out.refine_area_max / 2.0:
         raise r.fail(join(p, "refine_area_min"),

@@ -134,8 +134,9 @@ class Reader:
             raise self.fail(where, f"must be <= {le:g}, got {value:g}")
         return value
 
-    def integer(self, table: dict, path: str, key: str, default: Any = REQUIRED, *, ge=None):
-        """An integer with an optional lower bound."""
+    def integer(self, table: dict, path: str, key: str, default: Any = REQUIRED, *, ge=None,
+                le=None):
+        """An integer with optional bounds."""
         value = self._get(table, path, key, default)
         if value is default and key not in table:
             return value
@@ -144,6 +145,8 @@ class Reader:
             raise self.fail(where, f"expected an integer, got {describe(value)}")
         if ge is not None and value < ge:
             raise self.fail(where, f"must be >= {ge}, got {value}")
+        if le is not None and value > le:
+            raise self.fail(where, f"must be <= {le}, got {value}")
         return value
 
     def string(self, table: dict, path: str, key: str, default: Any = REQUIRED) -> str | None:

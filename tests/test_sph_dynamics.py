@@ -183,7 +183,7 @@ def test_segments_beyond_reach_are_skipped_without_changing_density_or_forces():
                                  model.blocked, wdist, *model.walls_near, model.seg)
                for i in range(p.n)]
         acc = np.empty((3, p.n))
-        forces.internal_acceleration(p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
+        forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                      model.nl.start, model.nl.nbr, model.blocked, wdist,
                                      *model.walls_near, model.seg, model.scheme, *acc)
         return np.array(rho), acc

@@ -151,7 +151,7 @@ def test_wall_lists_equal_a_brute_force_search():
     wstart, wseg, cstart, cpair = index.near_lists(x, y, h, nl.start, nl.nbr, nl.reach)
     blocked = np.empty(nl.nbr.size, dtype=np.bool_)
     wdist = np.empty(wseg.size)
-    walls.blocked_pairs(x, y, nl.start, nl.nbr, wstart, wseg, seg, blocked, wdist)
+    walls.blocked_pairs(nl.rows, x, y, nl.start, nl.nbr, wstart, wseg, seg, blocked, wdist)
     assert cpair.shape[0] > 50 and blocked.sum() > 100
     for i in range(0, n, 7):
         nbrs = nl.nbr[nl.start[i]:nl.start[i + 1]]

@@ -37,13 +37,14 @@ def _lerp(g, i0, j0, tx, ty):
 
 
 @njit(parallel=True, cache=True)
-def sample_bed(x, y, dx, dy, bed, bx, by, bxx, bxy, byy, manning, out):
-    """Sample the seven bed grids at every particle into ``out`` (n, 7).
+def sample_bed(rows, x, y, dx, dy, bed, bx, by, bxx, bxy, byy, manning, out):
+    """Sample the seven bed grids at the particles ``rows`` into their rows of ``out`` (n, 7).
 
     Columns: b [m], b_x, b_y [-], b_xx, b_xy, b_yy [m^-1], n [s m^-1/3].
     """
     ny, nx = bed.shape
-    for p in prange(x.shape[0]):
+    for k in prange(rows.shape[0]):
+        p = rows[k]
         i0, j0, tx, ty = _weights(x[p], y[p], dx, dy, nx, ny)
         out[p, 0] = _lerp(bed, i0, j0, tx, ty)
         out[p, 1] = _lerp(bx, i0, j0, tx, ty)

@@ -128,9 +128,9 @@ def _h_of_rho(h0, rho0, rho, h_ratio):
 
 
 @njit(parallel=True, cache=True)
-def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
-          cpair, seg, tol, max_iter, h_ratio, h_cap, h_shrink, iters):
-    """Newton-Raphson solve (1)-(3) of every particle, in place (gather form).
+def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, wstart, wseg,
+          cstart, cpair, seg, tol, max_iter, h_ratio, h_cap, h_shrink, iters):
+    """Newton-Raphson solve (1)-(3) of the particles ``rows``, in place (gather form).
 
     Only h_i changes the summation of particle i, so each particle iterates on its own to
     convergence. ``iters[i]`` receives the number of summations of particle i, negated when
@@ -148,7 +148,8 @@ def solve(x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, wstart,
     that h for good (a lone particle thrown up a beach kept h0 / 10, and with it a time step
     ten times too short).
     """
-    for i in prange(x.shape[0]):
+    for k in prange(rows.shape[0]):
+        i = rows[k]
         it = 0
         done = False
         h_low = h_shrink * h[i]
@@ -194,7 +195,7 @@ def predict(rho, h, divv, dt):
 
 def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0,
                   cap=False):
-    """Solve (1)-(3) for all particles of ``p`` in place.
+    """Solve (1)-(3) in place for the particles of ``p`` that ``nl`` lists (``nl.rows``).
 
     ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList;
     ``blocked`` its pairs separated by a wall and ``wdist`` the distances to the near
@@ -209,10 +210,10 @@ def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ra
     Returns (iterations, unconverged, capped, held); ``iterations`` is the largest number of
     summations any particle needed.
     """
-    iters = np.zeros(p.n, dtype=np.int64)
+    iters = np.ones(p.n, dtype=np.int64)  # rows not solved count as converged
     h_cap = nl.h_cap(p.x, p.y) if cap else np.full(p.n, np.inf)
-    solve(p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked, wdist,
-          *walls, seg, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, iters)
+    solve(nl.rows, p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked,
+          wdist, *walls, seg, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, iters)
     held = iters > max_iter
     return (int(np.abs(np.where(held, 0, iters)).max(initial=0)), int((iters < 0).sum()),
             int((iters == 0).sum()), int(held.sum()))

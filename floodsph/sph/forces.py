@@ -129,9 +129,9 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, image=False):
 
 
 @njit(parallel=True, cache=True)
-def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wdist, wstart, wseg,
-                          cstart, cpair, seg, scheme, ax, ay, divv):
-    """a^int and div v of every particle (gather form), mirror images included.
+def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wdist, wstart,
+                          wseg, cstart, cpair, seg, scheme, ax, ay, divv):
+    """a^int and div v of the particles ``rows`` (gather form), mirror images included.
 
     Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
     flagged in ``blocked`` (:func:`floodsph.sph.walls.blocked_pairs`) are left out with
@@ -143,7 +143,8 @@ def internal_acceleration(x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wd
     """
     coef = np.empty((x.shape[0], 3))
     pair_coefficients(rho, alpha, h, coef)
-    for i in prange(x.shape[0]):
+    for k in prange(rows.shape[0]):
+        i = rows[k]
         xi = x[i]
         yi = y[i]
         hi = h[i]
@@ -244,14 +245,15 @@ def _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s1, s2, scheme):
 
 
 @njit(parallel=True, cache=True)
-def add_bed_acceleration(u, v, bed, max_slope, ax, ay):
-    """Add the bed term of (5) to the internal accelerations (in place).
+def add_bed_acceleration(rows, u, v, bed, max_slope, ax, ay):
+    """Add the bed term of (5) to the internal accelerations of the particles ``rows``.
 
     ``bed`` is the (n, 7) sample of ``floodsph.sph.bed.sample_bed``. The slope is limited to
     ``max_slope`` in magnitude, and the normal-force factor to >= 0 (a column cannot be pulled
     into the bed).
     """
-    for i in prange(u.shape[0]):
+    for k in prange(rows.shape[0]):
+        i = rows[k]
         bx = bed[i, 1]
         by = bed[i, 2]
         s = math.sqrt(bx * bx + by * by)
@@ -266,6 +268,15 @@ def add_bed_acceleration(u, v, bed, max_slope, ax, ay):
         ay[i] -= f * by
 
 
+@njit(inline="always", cache=True)
+def friction_factor(u, v, rho, n, dt, d_floor):
+    """Semi-implicit Manning factor k = 1 / (1 + dt g n^2 |v| / max(d, d_floor)^(4/3)) [-]
+    of one particle (velocity [m s-1], rho [kg m-2], n [s m-1/3], dt [s], floor [m])."""
+    d = max(rho / RHO_WATER, d_floor)
+    speed = math.sqrt(u * u + v * v)
+    return 1.0 / (1.0 + dt * GRAVITY * n * n * speed / d ** (4.0 / 3.0))
+
+
 @njit(parallel=True, cache=True)
 def apply_friction(u, v, rho, manning, dt, d_floor):
     """Semi-implicit Manning friction: v <- v / (1 + dt g n^2 |v| / max(d, d_floor)^(4/3))."""
@@ -273,9 +284,7 @@ def apply_friction(u, v, rho, manning, dt, d_floor):
         n = manning[i]
         if n <= 0.0:
             continue
-        d = max(rho[i] / RHO_WATER, d_floor)
-        speed = math.sqrt(u[i] * u[i] + v[i] * v[i])
-        k = 1.0 / (1.0 + dt * GRAVITY * n * n * speed / d ** (4.0 / 3.0))
+        k = friction_factor(u[i], v[i], rho[i], n, dt, d_floor)
         u[i] *= k
         v[i] *= k
 

@@ -175,28 +175,31 @@ def _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_
 
 @njit(parallel=True, cache=True)
 def _count(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
-           lv_hmax, reach, nbr_start):
-    """Number of neighbours of every particle (itself excluded) into ``nbr_start[1:]``."""
+           lv_hmax, reach, rows, nbr_start):
+    """Number of neighbours of each particle in ``rows`` (itself excluded) into
+    ``nbr_start[i + 1]``."""
     buf = np.zeros(0, dtype=np.int64)
-    for i in prange(x.shape[0]):
+    for k in prange(rows.shape[0]):
+        i = rows[k]
         nbr_start[i + 1] = _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell,
                                    lv_ncx, lv_ncy, lv_off, lv_hmax, reach, buf, False) - 1
 
 
 @njit(parallel=True, cache=True)
 def _fill(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
-          lv_hmax, reach, nbr_start, chunk, nbr):
-    """Write the neighbours of every particle into ``nbr`` (CSR by ``nbr_start``).
+          lv_hmax, reach, rows, nbr_start, chunk, nbr):
+    """Write the neighbours of each particle in ``rows`` into ``nbr`` (CSR by ``nbr_start``).
 
-    Parallel over chunks of ``chunk`` particles, each with its own search buffer.
+    Parallel over chunks of ``chunk`` rows, each with its own search buffer.
     """
-    n = x.shape[0]
+    n = rows.shape[0]
     width = 0
-    for i in range(n):
+    for i in range(x.shape[0]):
         width = max(width, nbr_start[i + 1] - nbr_start[i])
     for c in prange((n + chunk - 1) // chunk):
         buf = np.empty(width + 2, dtype=np.int64)
-        for i in range(c * chunk, min(n, (c + 1) * chunk)):
+        for r in range(c * chunk, min(n, (c + 1) * chunk)):
+            i = rows[r]
             k = _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx,
                         lv_ncy, lv_off, lv_hmax, reach, buf, True)
             pos = nbr_start[i]
@@ -243,11 +246,17 @@ class NeighbourList:
         Positions [m] and smoothing lengths [m] of the active particles.
     skin : float
         Relative margin on the 2 max(h_i, h_j) support (see :meth:`still_valid`).
+    rows : int64 array, optional
+        List only these particles' neighbours (among all particles); the other rows are
+        empty. Local time stepping (``floodsph.sph.local_steps``) lists the particles that
+        end a step. Default: every particle.
     """
 
-    def __init__(self, x, y, h, skin=0.1):
+    def __init__(self, x, y, h, skin=0.1, rows=None):
         n = x.shape[0]
         self.skin = skin
+        self.complete = rows is None
+        self.rows = np.arange(n, dtype=np.int64) if rows is None else rows
         self.reach = 2.0 * (1.0 + skin)
         self.x_built = x.copy()
         self.y_built = y.copy()
@@ -274,7 +283,7 @@ class NeighbourList:
         _level_cell_ids(x, y, level, box, lv_cell, lv_ncx, lv_ncy, lv_off, cid)
         cell_start, order = counting_sort(cid, int(lv_off[-1]), _chunks(n))
         args = (x, y, h, x[order], y[order], h[order], order, cell_start, box, lv_cell, lv_ncx,
-                lv_ncy, lv_off, lv_hmax, self.reach)
+                lv_ncy, lv_off, lv_hmax, self.reach, self.rows)
         _count(*args, self.start)
         np.cumsum(self.start, out=self.start)
         self.nbr = np.empty(self.start[-1], dtype=np.int64)
@@ -285,9 +294,9 @@ class NeighbourList:
 
         With G = max h_i / h_b,i and D = max |x_i - x_b,i| / h_b,i (b: at the build), a pair
         within the support now was within 2 (G + D) max(h_b,i, h_b,j) at the build, so the
-        list is exact while G + D <= 1 + skin (same particle count required).
+        list is exact while G + D <= 1 + skin (same particle count, and every row listed).
         """
-        if x.shape[0] != self.x_built.shape[0]:
+        if not self.complete or x.shape[0] != self.x_built.shape[0]:
             return False
         if x.shape[0] == 0:
             return True

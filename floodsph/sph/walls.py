@@ -124,7 +124,8 @@ class WallIndex:
             return (wstart, np.zeros(0, dtype=np.int64), cstart,
                     np.zeros((0, 2), dtype=np.int64))
         args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items, self.clear,
-                self.xmin, self.ymin, self.lv_bucket, self.lv_nbx, self.lv_nby, self.lv_off)
+                self.xmin, self.ymin, self.lv_bucket, self.lv_nbx, self.lv_nby, self.lv_off,
+                float(h.max()))
         count = np.empty(n, dtype=np.int64)
         while True:  # one scan into rows of ``width``; again, wider, if a row overflowed
             rows = np.empty((n, self.width), dtype=np.int64)
@@ -207,23 +208,26 @@ def first_visit(seg, s, bx, by, qbx0, qby0, xmin, ymin, bucket, nbx, nby):
 
 @njit(parallel=True, cache=True)
 def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, xmin, ymin, lv_bucket,
-               lv_nbx, lv_nby, lv_off, rows, count):
+               lv_nbx, lv_nby, lv_off, h_top, rows, count):
     """Count (into ``count[i]``) and list (into ``rows[i]``, in index order, as far as the row
     is wide) each particle's segments within reach * max(h_i, max_j h_j); a particle inside
-    the level-0 grid whose radius is below its bucket's ``clear`` distance has none. The
+    the level-0 grid whose radius is below its bucket's ``clear`` distance has none (tested
+    first with the largest h of all, ``h_top``, before its neighbours are walked). The
     buckets walked are those of the finest level at least half as wide as the radius."""
     width = rows.shape[1]
     top = lv_bucket.shape[0] - 1
     for i in prange(x.shape[0]):
         count[i] = 0
+        cx = (x[i] - xmin) / lv_bucket[0]
+        cy = (y[i] - ymin) / lv_bucket[0]
+        inside = 0.0 <= cx < lv_nbx[0] and 0.0 <= cy < lv_nby[0]
+        if inside and reach * h_top < clear[int(cy) * lv_nbx[0] + int(cx)]:
+            continue
         hr = h[i]
         for k in range(nstart[i], nstart[i + 1]):
             hr = max(hr, h[nbr[k]])
         radius = reach * hr
-        cx = (x[i] - xmin) / lv_bucket[0]
-        cy = (y[i] - ymin) / lv_bucket[0]
-        if (0.0 <= cx < lv_nbx[0] and 0.0 <= cy < lv_nby[0]
-                and radius < clear[int(cy) * lv_nbx[0] + int(cx)]):
+        if inside and radius < clear[int(cy) * lv_nbx[0] + int(cx)]:
             continue
         lv = 0
         while lv < top and lv_bucket[lv] < 0.5 * radius:
@@ -392,8 +396,9 @@ also covers rounding, ~1e-10 m at 1e5 m from the origin)."""
 
 
 @njit(parallel=True, cache=True)
-def blocked_pairs(x, y, nstart, nbr, wstart, wseg, seg, out, wdist):
-    """out[q] = True when a wall near particle i separates it from its neighbour nbr[q].
+def blocked_pairs(rows, x, y, nstart, nbr, wstart, wseg, seg, out, wdist):
+    """out[q] = True when a wall near particle i separates it from its neighbour nbr[q], for
+    the particles i in ``rows`` (those whose neighbours are listed).
 
     Also ``wdist[k]``, the distance [m] from particle i to its near segment wseg[k]: a segment
     farther from i than r_ij + SIGHT_SLACK cannot hide j (:func:`hides`), and the density
@@ -401,7 +406,8 @@ def blocked_pairs(x, y, nstart, nbr, wstart, wseg, seg, out, wdist):
     Computed once per step (positions fixed) for the density iterations and the forces, which
     then skip blocked pairs and their mirror images at the cost of a lookup.
     """
-    for i in prange(x.shape[0]):
+    for r in prange(rows.shape[0]):
+        i = rows[r]
         xi = x[i]
         yi = y[i]
         nearest = np.inf

@@ -18,7 +18,8 @@ Results folder (default ``workflows/malpasset/results``):
   point / per mode) and ``particles.png`` (particle count and wall time against time).
 
 Usage: ``python workflows/malpasset/run_malpasset.py [--sea particles|sink|both]
-[--end-time S] [--spacing M] [--out DIR] [--overwrite] [--max-steps N]``
+[--end-time S] [--spacing M] [--refinement MODE] [--time-stepping global|local] [--out DIR]
+[--overwrite] [--max-steps N]``
 """
 
 from __future__ import annotations
@@ -44,7 +45,8 @@ PARTICLE_COUNT_INTERVAL_S = 10.0
 def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_TIME_S,
                 spacing: float = 20.0, gauge_interval: float = 5.0, overwrite: bool = False,
                 max_steps: int | None = None, progress: bool = True,
-                threads: int | None = None, refinement: str | None = None) -> dict:
+                threads: int | None = None, refinement: str | None = None,
+                time_stepping: str | None = None) -> dict:
     """Write, run and report one sea mode in ``out/<sea>/``; returns its cost row."""
     from floodsph.run import run_scenario
     from floodsph.scenario import load_scenario
@@ -52,7 +54,7 @@ def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_T
 
     where = out / sea
     path = setup.write_scenario(folder, where, sea, end_time, spacing, gauge_interval,
-                                refinement)
+                                refinement, time_stepping)
     counter = results.ParticleCounter()
     run_dir = where / "run"
     run_scenario(load_scenario(path), out_dir=run_dir, overwrite=overwrite, progress=progress,
@@ -121,6 +123,7 @@ def _child(args, sea: str) -> int:
     cmd += ["--max-steps", str(args.max_steps)] if args.max_steps else []
     cmd += ["--threads", str(args.threads)] if args.threads is not None else []
     cmd += ["--refinement", args.refinement] if args.refinement else []
+    cmd += ["--time-stepping", args.time_stepping] if args.time_stepping else []
     return subprocess.run(cmd, check=False).returncode
 
 
@@ -141,6 +144,8 @@ def main(argv=None) -> int:
                         help="numba threads (default: all cores)")
     parser.add_argument("--refinement", choices=("split+coalesce", "split", "none"),
                         default=None, help="numerics.refinement (default: floodsph's)")
+    parser.add_argument("--time-stepping", choices=("global", "local"), default=None,
+                        help="numerics.time_stepping (default: floodsph's, global)")
     parser.add_argument("--no-summary", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--write-static", action="store_true",
                         help="(re)write workflows/malpasset/scenario.toml and exit")
@@ -168,7 +173,8 @@ def main(argv=None) -> int:
         try:
             run_variant(folder, args.out, args.sea, args.end_time, args.spacing,
                         args.gauge_interval, args.overwrite, args.max_steps,
-                        threads=args.threads, refinement=args.refinement)
+                        threads=args.threads, refinement=args.refinement,
+                        time_stepping=args.time_stepping)
         except InputError as exc:
             print(f"Error: {exc}", file=sys.stderr)
             return 2
