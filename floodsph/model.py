@@ -232,14 +232,14 @@ class FloodModel:
         half = 0.5 * dt_f
         for sub in range(n_sub):
             self._nl_fresh = False
-            begin, _ = local_steps.substep_rows(p.stride, sub)
+            begin = local_steps.step_ends(p.stride, sub)
             local_steps.kick(begin, p.stride, half, p.u, p.v, p.ax, p.ay)
             self._move(dt_f)
             p.stride[p.stride == 0] = 1  # water that entered in this substep: finest stride
             last = sub == n_sub - 1
             if last:
                 self._synchronise(n_sub)  # new particles inherit their parents' strides
-            end = None if last else local_steps.substep_rows(p.stride, sub)[1]
+            end = None if last else local_steps.step_ends(p.stride, sub + 1)
             self._interactions(rows=end)
             end = np.arange(p.n, dtype=np.int64) if end is None else end
             local_steps.close_steps(end, p.stride, dt_f, p.u, p.v, p.ax, p.ay, p.rho,

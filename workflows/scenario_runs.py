@@ -2,8 +2,8 @@
 
 Shared by ``refinement_benchmark.py`` and ``speed_vs_error.py``: a scenario is loaded, its
 refinement mode, particle spacing, end time or refinement thresholds replaced, and run through
-the real chain (``floodsph.run.run_scenario``: run folder, maps, ``run.json``) while a callback
-adds up the particle count of every step (particle-steps, the solver's work measure).
+the real chain (``floodsph.run.run_scenario``: run folder, maps, ``run.json``, whose
+``particle_updates`` is the particle-steps, the solver's work measure).
 """
 
 from __future__ import annotations
@@ -15,20 +15,6 @@ from pathlib import Path
 WET_M = 0.1
 """Wet threshold [m] of the map comparisons (CSI)."""
 REFINE_KEYS = ("refine_area_max", "refine_area_min", "refine_d_min_m", "refine_max_level")
-
-
-class StepCounter:
-    """Simulation callback adding up the particle count of every step (particle-steps)."""
-
-    def __init__(self):
-        self.particle_steps = 0
-        self.last_step = 0
-
-    def __call__(self, sim) -> None:
-        steps = sim.model.steps
-        if steps > self.last_step:
-            self.particle_steps += (steps - self.last_step) * sim.n
-            self.last_step = steps
 
 
 def variant(path: Path, out: Path, mode: str | None = None, spacing: float | None = None,
@@ -58,12 +44,10 @@ def variant(path: Path, out: Path, mode: str | None = None, spacing: float | Non
 def run(scenario, out: Path, max_steps: int | None = None, **labels) -> dict:
     """Run ``scenario`` into ``out``; return its row: ``labels``, then cost and counters."""
     import floodsph.run as runner
-    from floodsph.schedules import IterationInterval
 
-    counter = StepCounter()
     t0 = time.perf_counter()
     manifest = runner.run_scenario(scenario, out, max_steps=max_steps, progress=False,
-                                   overwrite=True, callbacks=[(counter, IterationInterval(1))])
+                                   overwrite=True)
     wall = time.perf_counter() - t0
     row = {**labels, "mode": scenario.numerics.refinement.value,
            "spacing_m": manifest["particle_spacing_m"], "wall_s": round(wall, 1),
@@ -71,7 +55,7 @@ def run(scenario, out: Path, max_steps: int | None = None, **labels) -> dict:
            "particles_initial": manifest["particles_initial"],
            "particles_max": manifest["particles_max"],
            "particles_final": manifest["particles_final"],
-           "particle_steps": counter.particle_steps,
+           "particle_steps": manifest["particle_updates"],
            "splits": manifest["splits"], "merges": manifest["merges"],
            "mass_error_rel": manifest.get("mass_error_rel")}
     print(row, flush=True)

@@ -106,24 +106,16 @@ def close_steps(rows, stride, dt_fine, u, v, ax, ay, rho, manning, d_floor):
 
 
 @njit(cache=True)
-def substep_rows(stride, substep):
-    """(begin, end): the particles whose own step begins at finest step ``substep`` of the big
-    step (substep % s_i == 0), and those whose step ends with it ((substep + 1) % s_i == 0);
-    strides divide the big step."""
-    n_begin = 0
-    n_end = 0
+def step_ends(stride, k):
+    """The particles one of whose own steps ends (and the next begins) at finest step k of
+    the big step, k % s_i == 0 (strides divide the big step, so k = 0 and k = 2^K hold all)."""
+    count = 0
     for i in range(stride.shape[0]):
-        n_begin += substep % stride[i] == 0
-        n_end += (substep + 1) % stride[i] == 0
-    begin = np.empty(n_begin, dtype=np.int64)
-    end = np.empty(n_end, dtype=np.int64)
-    b = 0
-    e = 0
+        count += k % stride[i] == 0
+    out = np.empty(count, dtype=np.int64)
+    c = 0
     for i in range(stride.shape[0]):
-        if substep % stride[i] == 0:
-            begin[b] = i
-            b += 1
-        if (substep + 1) % stride[i] == 0:
-            end[e] = i
-            e += 1
-    return begin, end
+        if k % stride[i] == 0:
+            out[c] = i
+            c += 1
+    return out
