@@ -9,7 +9,7 @@ method notes 2.6-2.7):
           leave an open border or enter nodata are removed and counted as outflow
 3. density guess from continuity, neighbour lists, Newton-Raphson solve of rho and h
 4. forces a^{n+1} at (x^{n+1}, v^{n+1/2}): pressure + shock capturing + bed
-5. kick   v^{n+1} = v^{n+1/2} + a^{n+1} dt / 2, then semi-implicit Manning friction over dt
+5. kick   v^{n+1} = v^{n+1/2} + a^{n+1} dt / 2, then implicit Manning friction over dt
 6. next dt = cfl min h / (|v| + c)
 
 With ``Numerics.time_stepping = "local"`` a call to :meth:`FloodModel.step` takes one big step
