@@ -57,9 +57,11 @@ class Numerics:
     stabilisation : "lax-friedrichs" (parameter-free, default) or "riemann".
     friction_depth_floor : depth floor [m] of the Manning term.
     max_slope : bed slopes steeper than this are limited in the bed term.
-    neighbour_skin : relative margin of the neighbour lists.
+    neighbour_skin : relative margin of the neighbour lists (local time stepping takes at most
+        ``local_steps.LIST_SKIN``).
     reorder_interval : steps between spatial re-sorts of the particle arrays.
-    refinement : "none" (splitting and coalescing arrive with the refinement module).
+    refinement : the scenario's refinement mode, as a label (the ``refiner`` given to
+        ``FloodModel`` splits and coalesces).
     time_stepping : "global" (one step for all particles) or "local" (each particle at its
         own power-of-two multiple of the finest step, ``floodsph.sph.local_steps``).
     step_levels : K of local stepping: a big step holds 2^K finest steps.
@@ -154,6 +156,7 @@ class FloodModel:
         self.wdist = np.empty(0)
         self._blocked_nl = None
         self._nl_fresh = False  # lists built in this step
+        self._h_median = 1.0  # median h at the start of a big step (local time stepping)
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
         self._settle_seeds()
@@ -229,6 +232,7 @@ class FloodModel:
         for boundary in self.boundaries:
             zone |= boundary.protected(p.x, p.y)
         p.stride[zone] = 1
+        self._h_median = float(np.median(p.h)) if p.n else 1.0
         half = 0.5 * dt_f
         for sub in range(n_sub):
             self._nl_fresh = False
@@ -357,7 +361,8 @@ class FloodModel:
         (``hgrow``, at most ``MAX_SEARCH_GROWTH``), so that a particle whose h keeps growing
         in the solves (a thinning edge) is not held back by its lists step after step
         (:meth:`_solve_density`). ``rows``: list only these particles' neighbours (the
-        near-wall lists still cover every particle, for the drift).
+        near-wall lists still cover every particle, for the drift). Local time stepping
+        builds its lists with the skin ``local_steps.LIST_SKIN``.
         """
         p = self.particles
         nl = getattr(self, "nl", None)
@@ -365,8 +370,11 @@ class FloodModel:
             return
         self._nl_fresh = True
         h_search = p.h * np.clip(p.hgrow, 1.0, MAX_SEARCH_GROWTH)
-        self.nl = NeighbourList(p.x, p.y, h_search, skin=self.numerics.neighbour_skin,
-                                rows=rows)
+        skin = self.numerics.neighbour_skin
+        if self.numerics.time_stepping == "local":
+            skin = min(skin, local_steps.LIST_SKIN)
+        self.nl = NeighbourList(p.x, p.y, h_search, skin=skin, rows=rows,
+                                h_median=None if rows is None else self._h_median)
         self.walls_near = self.wall_index.near_lists(p.x, p.y, h_search, self.nl.start,
                                                      self.nl.nbr, self.nl.reach)
 

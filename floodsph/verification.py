@@ -47,6 +47,7 @@ class CaseResult:
     particles_max: int = 0
     splits: int = 0
     merges: int = 0
+    time_stepping: str = "global"
 
     @property
     def particle_steps_per_s(self) -> float:
@@ -93,11 +94,12 @@ def _run(model, t_end):
     return time.perf_counter() - t0, model.counters["particle_updates"] - pst, pairs
 
 
-def _refinement_counts(refinement, model) -> tuple:
-    """(mode, particles_max, splits, merges) of a finished run, for ``CaseResult``."""
+def _labels(refinement, model) -> tuple:
+    """(mode, particles_max, splits, merges, time_stepping) of a finished run, for
+    ``CaseResult``."""
     c = model.counters
     mode = "none" if refinement is None else refinement.mode
-    return mode, c["particles_max"], c["splits"], c["merges"]
+    return mode, c["particles_max"], c["splits"], c["merges"], model.numerics.time_stepping
 
 
 def _depth_at(model, qx, qy):
@@ -127,7 +129,7 @@ def ritter(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseRe
     front = exact.front_position(xq, d, 0.1) - exact.front_position(xq, d_ex, 0.1)
     return CaseResult("ritter", dx, model.particles.n, model.steps, wall, pst, pairs,
                       exact.l1_relative(d, d_ex), float(front),
-                      abs(model.volume() - v0) / v0, *_refinement_counts(refinement, model))
+                      abs(model.volume() - v0) / v0, *_labels(refinement, model))
 
 
 def stoker(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseResult:
@@ -147,7 +149,7 @@ def stoker(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseRe
     front = bore - exact.stoker_bore_position(t_end, d_l, d_r, x_dam=1000.0)
     return CaseResult("stoker", dx, model.particles.n, model.steps, wall, pst, pairs,
                       exact.l1_relative(d, d_ex), float(front),
-                      abs(model.volume() - v0) / v0, *_refinement_counts(refinement, model))
+                      abs(model.volume() - v0) / v0, *_labels(refinement, model))
 
 
 def thacker(dx: float, kappa: float = 1.3, periods: float = 1.0, refinement=None,
@@ -172,7 +174,7 @@ def thacker(dx: float, kappa: float = 1.3, periods: float = 1.0, refinement=None
     r_wet = np.hypot(X.ravel() - eta, Y.ravel())[(d > 1e-3)]
     shore = float(r_wet.max() - a) if r_wet.size else np.nan
     return CaseResult("thacker", dx, model.particles.n, model.steps, wall, pst, pairs, l1,
-                      shore, abs(model.volume() - v0) / v0, *_refinement_counts(refinement, model))
+                      shore, abs(model.volume() - v0) / v0, *_labels(refinement, model))
 
 
 CASES = {"ritter": ritter, "stoker": stoker, "thacker": thacker}

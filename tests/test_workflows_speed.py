@@ -36,8 +36,18 @@ def test_speed_vs_error_analytic_rows_and_report(tmp_path):
         assert 0.0 < float(r["l1"]) < 0.015  # the coarse Stoker target of the core tests
         assert abs(float(r["front_error_m"])) <= 20.0 and float(r["mass_error_rel"]) < 1e-12
     report = (tmp_path / "speed_vs_error.md").read_text()
-    assert "| stoker | none | 10 |" in report and "speed_vs_error.png" in report
+    assert "| stoker | none | global | 10 |" in report and "speed_vs_error.png" in report
     assert (tmp_path / "speed_vs_error.png").stat().st_size > 10_000
+
+
+def test_speed_vs_error_runs_both_time_steppings(tmp_path):
+    speed.main(["--quick", "--cases", "stoker", "--modes", "none", "--time-stepping", "global",
+                "local", "--no-throughput", "--out", str(tmp_path)])
+    glob, loc = _rows(tmp_path / "speed_vs_error.csv")
+    assert (glob["time_stepping"], loc["time_stepping"]) == ("global", "local")
+    assert float(loc["mass_error_rel"]) < 1e-12
+    assert float(loc["l1"]) < 1.1 * float(glob["l1"])  # same error as the global step
+    assert abs(float(loc["front_error_m"])) <= 20.0
 
 
 def test_speed_vs_error_real_cases_agree_with_their_reference(tmp_path):
@@ -48,7 +58,7 @@ def test_speed_vs_error_real_cases_agree_with_their_reference(tmp_path):
     rows = _rows(tmp_path / "real_cases.csv")
     assert {r["mode"] for r in rows} == {"none", "split", "split+coalesce"}
     for r in rows:
-        assert r["reference"] == f"split+coalesce {r['spacing_m']} m"
+        assert r["reference"] == f"split+coalesce {r['spacing_m']} m global"
         assert int(r["steps"]) == 2 and float(r["mass_error_rel"]) < 1e-12
         if r["mode"] == "split+coalesce":  # the reference against itself
             assert r["csi"] in ("1", "nan") and r["rmse_m"] in ("0", "nan")
@@ -57,10 +67,12 @@ def test_speed_vs_error_real_cases_agree_with_their_reference(tmp_path):
 
 def test_refinement_benchmark_two_steps_on_the_valley(tmp_path):
     bench.main(["--cases", "valley", "--modes", "none", "split", "--max-steps", "2",
-                "--out", str(tmp_path)])
+                "--time-stepping", "local", "--out", str(tmp_path)])
     rows = _rows(tmp_path / "refinement_benchmark.csv")
-    assert [r["mode"] for r in rows] == ["none", "split"]
-    assert all(int(r["steps"]) == 2 and float(r["mass_error_rel"]) < 1e-12 for r in rows)
+    assert [(r["mode"], r["time_stepping"]) for r in rows] == [("none", "local"),
+                                                               ("split", "local")]
+    # two big steps of 2^3 finest steps each (run.json counts the finest steps)
+    assert all(int(r["steps"]) == 16 and float(r["mass_error_rel"]) < 1e-12 for r in rows)
     (pair,) = _rows(tmp_path / "agreement.csv")
     assert (pair["mode"], pair["against"]) == ("split", "none")
     assert float(pair["csi"]) > 0.99  # two steps: the same water in both

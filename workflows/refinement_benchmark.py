@@ -19,6 +19,7 @@ markdown tables. Wall times depend on the machine's load: compare the ratios wit
     python workflows/refinement_benchmark.py [--out results/refinement_benchmark]
         [--cases valley malpasset] [--modes none split split+coalesce] [--max-steps N]
         [--malpasset-spacing 40] [--malpasset-end-time 1000] [--set refine_area_min=0.5 ...]
+        [--time-stepping global|local]
 """
 
 from __future__ import annotations
@@ -41,13 +42,15 @@ MALPASSET_END_S = 1000.0
 
 
 def scenario_for(case: str, mode: str, out: Path, spacing: float | None = None,
-                 end_time: float | None = None, settings: dict | None = None):
+                 end_time: float | None = None, settings: dict | None = None,
+                 time_stepping: str | None = None):
     """The case's scenario with ``mode`` and ``out`` as the run folder.
 
-    ``spacing`` [m] and ``end_time`` [s] override the scenario's particle spacing and end
-    time. Malpasset's scenario is written next to ``out`` from the benchmark data found by
-    ``malpasset_setup.data_folder`` (the sea as particles, 20 m spacing and 1000 s unless
-    overridden). Returns None (after printing why) when the case's data is missing.
+    ``spacing`` [m], ``end_time`` [s] and ``time_stepping`` override the scenario's particle
+    spacing, end time and time stepping. Malpasset's scenario is written next to ``out``
+    from the benchmark data found by ``malpasset_setup.data_folder`` (the sea as particles,
+    20 m spacing and 1000 s unless overridden). Returns None (after printing why) when the
+    case's data is missing.
     """
     path = CASES[case]
     if case == "malpasset":
@@ -58,7 +61,7 @@ def scenario_for(case: str, mode: str, out: Path, spacing: float | None = None,
         end_time = end_time or MALPASSET_END_S
         path = mp_setup.write_scenario(folder, out.parent / f"{out.name}_inputs", "particles",
                                        end_time, spacing or 20.0)
-    return runs.variant(path, out, mode, spacing, end_time, settings)
+    return runs.variant(path, out, mode, spacing, end_time, settings, time_stepping)
 
 
 def main(argv=None) -> None:
@@ -73,6 +76,8 @@ def main(argv=None) -> None:
                     help="simulated time [s] for Malpasset (default 1000 s)")
     ap.add_argument("--set", nargs="+", default=[], metavar="KEY=VALUE",
                     help="[numerics] refinement keys, e.g. refine_area_min=0.5")
+    ap.add_argument("--time-stepping", choices=("global", "local"), default=None,
+                    help="numerics.time_stepping of every run (default: the scenario's)")
     args = ap.parse_args(argv)
     out = args.out.resolve()
     settings = {}
@@ -91,7 +96,8 @@ def main(argv=None) -> None:
             mp = case == "malpasset"
             scenario = scenario_for(case, mode, out / case / mode,
                                     args.malpasset_spacing if mp else None,
-                                    args.malpasset_end_time if mp else None, settings)
+                                    args.malpasset_end_time if mp else None, settings,
+                                    args.time_stepping)
             if scenario is not None:
                 rows.append(runs.run(scenario, out / case / mode, args.max_steps, case=case))
                 done.append(mode)

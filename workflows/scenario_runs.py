@@ -18,13 +18,15 @@ REFINE_KEYS = ("refine_area_max", "refine_area_min", "refine_d_min_m", "refine_m
 
 
 def variant(path: Path, out: Path, mode: str | None = None, spacing: float | None = None,
-            end_time: float | None = None, settings: dict | None = None):
+            end_time: float | None = None, settings: dict | None = None,
+            time_stepping: str | None = None):
     """The scenario at ``path`` with ``out`` as its run folder and the given replacements.
 
     ``mode``: ``numerics.refinement``; ``spacing`` [m]: ``particle_spacing_m``; ``end_time``
-    [s]; ``settings``: ``[numerics]`` refinement keys (:data:`REFINE_KEYS`).
+    [s]; ``settings``: ``[numerics]`` refinement keys (:data:`REFINE_KEYS`);
+    ``time_stepping``: ``numerics.time_stepping`` (``"global"`` or ``"local"``).
     """
-    from floodsph.scenario import Refinement, load_scenario
+    from floodsph.scenario import Refinement, TimeStepping, load_scenario
 
     scenario = load_scenario(path)
     numerics = dict(settings or {})
@@ -32,6 +34,8 @@ def variant(path: Path, out: Path, mode: str | None = None, spacing: float | Non
         numerics["refinement"] = Refinement(mode)
     if spacing is not None:
         numerics["particle_spacing_m"] = spacing
+    if time_stepping is not None:
+        numerics["time_stepping"] = TimeStepping(time_stepping)
     info = scenario.scenario
     if end_time is not None:
         info = dataclasses.replace(info, end_time_s=end_time)
@@ -50,6 +54,7 @@ def run(scenario, out: Path, max_steps: int | None = None, **labels) -> dict:
                                    overwrite=True)
     wall = time.perf_counter() - t0
     row = {**labels, "mode": scenario.numerics.refinement.value,
+           "time_stepping": scenario.numerics.time_stepping.value,
            "spacing_m": manifest["particle_spacing_m"], "wall_s": round(wall, 1),
            "sim_time_s": manifest["sim_time_s"], "steps": manifest["steps"],
            "particles_initial": manifest["particles_initial"],

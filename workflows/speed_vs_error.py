@@ -2,7 +2,8 @@
 
 * **Analytic cases** (``floodsph.verification``): Ritter and Stoker dam breaks and Thacker's
   basin at three spacings each, in each refinement mode (default: all three, ``none``,
-  ``split`` and ``split+coalesce``); the error is the L1 relative depth error against the
+  ``split`` and ``split+coalesce``) and each time stepping (``--time-stepping``, default
+  global; ``global local`` runs both); the error is the L1 relative depth error against the
   exact solution.
 * **Real cases**: Malpasset (``workflows/malpasset/scenario.toml``, 1000 s, the sea as
   particles) and EA Test 4 (``workflows/ea_test4``, 18000 s) at three particle spacings in
@@ -22,7 +23,8 @@ are wall-clock on this machine: compare rows of one run, not runs on different d
 
     python workflows/speed_vs_error.py [--out results/speed_vs_error] [--quick]
         [--cases ritter stoker thacker malpasset ea_test4] [--modes none split split+coalesce]
-        [--max-steps N] [--real-spacings DX [DX ...]] [--no-throughput]
+        [--max-steps N] [--real-spacings DX [DX ...]] [--time-stepping global local]
+        [--no-throughput]
     python workflows/speed_vs_error.py --throughput-only [--repeats 5] [--skin 0.3]
 
 Throughput: every kernel is compiled on a small block first, the big block is built and
@@ -118,6 +120,8 @@ def main(argv=None) -> None:
     ap.add_argument("--quick", action="store_true", help="one coarse spacing per case")
     ap.add_argument("--cases", nargs="+", choices=[*ANALYTIC, *REAL], default=[*ANALYTIC, *REAL])
     ap.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES))
+    ap.add_argument("--time-stepping", nargs="+", choices=STEPPINGS, default=["global"],
+                    help="numerics.time_stepping of the analytic and real cases")
     ap.add_argument("--max-steps", type=int, default=None, help="real cases: stop after N steps")
     ap.add_argument("--real-spacings", nargs="+", type=float, default=None,
                     help="particle spacings [m] of the real cases (default: each case's three)")
@@ -136,11 +140,13 @@ def main(argv=None) -> None:
         for name in names:
             for dx in (QUICK if args.quick else SPACINGS)[name]:
                 for mode in args.modes:
-                    rows.append(cases.CASES[name](dx, refinement=_refinement(mode)))
-                    print_row(rows[-1])
+                    for stepping in args.time_stepping:
+                        rows.append(cases.CASES[name](dx, refinement=_refinement(mode),
+                                                      time_stepping=stepping))
+                        print_row(rows[-1])
         for name in (c for c in args.cases if c in REAL):
             real += real_case(name, out / name, args.modes, args.quick, args.max_steps,
-                              args.real_spacings)
+                              args.real_spacings, args.time_stepping)
     speed = []
     if not args.no_throughput:
         numerics = {} if args.skin is None else {"neighbour_skin": args.skin}
@@ -185,10 +191,10 @@ def real_scenario(case: str, out: Path) -> Path | None:
 
 
 def real_case(case: str, out: Path, modes, quick: bool, max_steps: int | None,
-              spacings=None) -> list[dict]:
+              spacings=None, steppings=("global",)) -> list[dict]:
     """Runs of a real case at its spacings (``spacings``, default the case's own) in each
-    mode, with their agreement with the finest ``split+coalesce`` run (or the finest run of
-    the first mode without it)."""
+    mode and time stepping, with their agreement with the finest ``split+coalesce`` run (or
+    the finest run of the first mode without it) of the first time stepping."""
     path = real_scenario(case, out)
     if path is None:
         return []
@@ -197,12 +203,14 @@ def real_case(case: str, out: Path, modes, quick: bool, max_steps: int | None,
     rows = []
     for dx in spacings:
         for mode in modes:
-            folder = out / f"{mode}_{dx:g}m"
-            scenario = runs.variant(path, folder, mode, dx)
-            rows.append(runs.run(scenario, folder, max_steps, case=case) | {"run": folder})
+            for stepping in steppings:
+                folder = out / f"{mode}_{dx:g}m_{stepping}"
+                scenario = runs.variant(path, folder, mode, dx, time_stepping=stepping)
+                rows.append(runs.run(scenario, folder, max_steps, case=case) | {"run": folder})
     ref_mode = "split+coalesce" if "split+coalesce" in modes else modes[0]
-    ref = min((r for r in rows if r["mode"] == ref_mode), key=lambda r: r["spacing_m"])
-    name, ref_run = f"{ref_mode} {ref['spacing_m']:g} m", ref["run"]
+    ref = min((r for r in rows if r["mode"] == ref_mode and r["time_stepping"] == steppings[0]),
+              key=lambda r: r["spacing_m"])
+    name, ref_run = f"{ref_mode} {ref['spacing_m']:g} m {steppings[0]}", ref["run"]
     for r in rows:
         r.update(reference=name, **runs.agreement(r.pop("run"), ref_run))
     return rows
@@ -215,16 +223,18 @@ ANALYTIC = tuple(SPACINGS)
 REAL = {"malpasset": {"spacings": (80.0, 60.0, 40.0), "end_time": 1000.0},
         "ea_test4": {"spacings": (20.0, 10.0, 5.0), "end_time": ea4.END_TIME_S}}
 MODES = ("none", "split", "split+coalesce")
-CSV_COLUMNS = ["case", "refinement", "spacing", "particles", "particles_max", "steps", "wall_s",
-               "l1", "front_error_m", "mass_error_rel", "particle_steps_per_s",
+STEPPINGS = ("global", "local")
+CSV_COLUMNS = ["case", "refinement", "time_stepping", "spacing", "particles", "particles_max",
+               "steps", "wall_s", "l1", "front_error_m", "mass_error_rel", "particle_steps_per_s",
                "interactions_per_s"]
-REAL_COLUMNS = ["case", "mode", "spacing_m", "wall_s", "sim_time_s", "steps",
+REAL_COLUMNS = ["case", "mode", "time_stepping", "spacing_m", "wall_s", "sim_time_s", "steps",
                 "particles_initial", "particles_max", "particle_steps", "splits", "merges",
                 "mass_error_rel", "reference", "csi", "rmse_m", "bias_m"]
 
 
 def print_row(r: cases.CaseResult) -> None:
-    print(f"{r.case:10s} {r.refinement:14s} dx={r.spacing:7.1f} n={r.particles:7d} "
+    print(f"{r.case:10s} {r.refinement:14s} {r.time_stepping:6s} dx={r.spacing:7.1f} "
+          f"n={r.particles:7d} "
           f"steps={r.steps:5d} wall={r.wall_s:8.2f}s L1={r.l1:.4f} "
           f"front_err={r.front_error_m:8.1f}m mass_err={r.mass_error_rel:.1e} "
           f"particle-steps/s={r.particle_steps_per_s:,.0f} "
@@ -253,7 +263,8 @@ def report(analytic, real, speed, picture, argv) -> str:
              "this run: compare rows, not runs.", ""]
     if analytic:
         lines += ["## Analytic cases (error against the exact solution)", "",
-                  markdown([{"case": r.case, "refinement": r.refinement, "spacing m": r.spacing,
+                  markdown([{"case": r.case, "refinement": r.refinement,
+                             "time stepping": r.time_stepping, "spacing m": r.spacing,
                              "peak particles": r.particles_max, "steps": r.steps,
                              "wall s": r.wall_s, "L1": r.l1, "front error m": r.front_error_m,
                              "mass error": r.mass_error_rel} for r in analytic]), ""]
@@ -264,7 +275,8 @@ def report(analytic, real, speed, picture, argv) -> str:
                   "run (wet = 0.1 m; RMSE over cells wet in both). The reference scores "
                   "itself perfectly, and a run at its spacing in another mode measures the "
                   "difference between the modes, not a convergence error.", "",
-                  markdown([{k: r[k] for k in ("case", "mode", "spacing_m", "reference", "wall_s",
+                  markdown([{k: r[k] for k in ("case", "mode", "time_stepping", "spacing_m",
+                                               "reference", "wall_s",
                                                "particles_max", "particle_steps",
                                                "mass_error_rel", "csi", "rmse_m")}
                             for r in real]), ""]
@@ -281,7 +293,8 @@ def report(analytic, real, speed, picture, argv) -> str:
 
 
 def plot(path: Path, analytic, real) -> Path | None:
-    """Error against wall time, one log-log panel per case, one line per mode."""
+    """Error against wall time, one log-log panel per case, one line per mode and time
+    stepping."""
     try:
         import matplotlib
 
@@ -293,24 +306,29 @@ def plot(path: Path, analytic, real) -> Path | None:
     series = []
     for name in ANALYTIC:
         for mode in MODES:
-            sel = [(r.wall_s, r.l1, r.spacing) for r in analytic
-                   if r.case == name and r.refinement == mode]
-            series.append((name, "L1 relative depth error", mode, sel))
+            for stepping in STEPPINGS:
+                sel = [(r.wall_s, r.l1, r.spacing) for r in analytic if r.case == name
+                       and r.refinement == mode and r.time_stepping == stepping]
+                series.append((name, "L1 relative depth error", mode, stepping, sel))
     for name in REAL:
         for mode in MODES:
-            sel = [(r["wall_s"], r["rmse_m"], r["spacing_m"]) for r in real
-                   if r["case"] == name and r["mode"] == mode and r["rmse_m"] > 0]
-            series.append((name, "max-depth RMSE vs reference [m]", mode, sel))
-    panels = [n for n in (*ANALYTIC, *REAL) if any(s[0] == n and s[3] for s in series)]
+            for stepping in STEPPINGS:
+                sel = [(r["wall_s"], r["rmse_m"], r["spacing_m"]) for r in real
+                       if r["case"] == name and r["mode"] == mode
+                       and r["time_stepping"] == stepping and r["rmse_m"] > 0]
+                series.append((name, "max-depth RMSE vs reference [m]", mode, stepping, sel))
+    panels = [n for n in (*ANALYTIC, *REAL) if any(s[0] == n and s[4] for s in series)]
     if not panels:
         return None
     fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.8), squeeze=False)
     for ax, name in zip(axes[0], panels, strict=True):
-        for case, label, mode, sel in series:
+        for case, label, mode, stepping, sel in series:
             if case != name or not sel:
                 continue
             wall, err, dx = zip(*sel, strict=True)
-            ax.loglog(wall, err, "o-" if mode == "none" else "s--", label=mode)
+            ax.loglog(wall, err, ("o" if mode == "none" else "s")
+                      + ("-" if stepping == "global" else ":"),
+                      label=mode if stepping == "global" else f"{mode}, local")
             for w, e, d in sel:
                 ax.annotate(f"{d:g} m", (w, e), fontsize=7)
             ax.set_ylabel(label)
