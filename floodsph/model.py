@@ -57,8 +57,7 @@ class Numerics:
     stabilisation : "lax-friedrichs" (parameter-free, default) or "riemann".
     friction_depth_floor : depth floor [m] of the Manning term.
     max_slope : bed slopes steeper than this are limited in the bed term.
-    neighbour_skin : relative margin of the neighbour lists (local time stepping takes at most
-        ``local_steps.LIST_SKIN``).
+    neighbour_skin : relative margin of the neighbour lists.
     reorder_interval : steps between spatial re-sorts of the particle arrays.
     refinement : the scenario's refinement mode, as a label (the ``refiner`` given to
         ``FloodModel`` splits and coalesces).
@@ -361,8 +360,8 @@ class FloodModel:
         (``hgrow``, at most ``MAX_SEARCH_GROWTH``), so that a particle whose h keeps growing
         in the solves (a thinning edge) is not held back by its lists step after step
         (:meth:`_solve_density`). ``rows``: list only these particles' neighbours (the
-        near-wall lists still cover every particle, for the drift). Local time stepping
-        builds its lists with the skin ``local_steps.LIST_SKIN``.
+        near-wall lists still cover every particle, for the drift; local time stepping
+        passes the median h of its big step, which sets the search levels).
         """
         p = self.particles
         nl = getattr(self, "nl", None)
@@ -370,11 +369,8 @@ class FloodModel:
             return
         self._nl_fresh = True
         h_search = p.h * np.clip(p.hgrow, 1.0, MAX_SEARCH_GROWTH)
-        skin = self.numerics.neighbour_skin
-        if self.numerics.time_stepping == "local":
-            skin = min(skin, local_steps.LIST_SKIN)
-        self.nl = NeighbourList(p.x, p.y, h_search, skin=skin, rows=rows,
-                                h_median=None if rows is None else self._h_median)
+        self.nl = NeighbourList(p.x, p.y, h_search, skin=self.numerics.neighbour_skin,
+                                rows=rows, h_median=None if rows is None else self._h_median)
         self.walls_near = self.wall_index.near_lists(p.x, p.y, h_search, self.nl.start,
                                                      self.nl.nbr, self.nl.reach)
 

@@ -26,13 +26,6 @@ K = ``Numerics.step_levels`` = 3 by default: EA test 4 at 5 m (README) took 680,
 624 s with K = 2, 3 and 4 on two cores, with the same maps (CSI 0.993, 0.992 and 0.990
 against the global step); a larger K saves synchronisations but adds updates.
 
-The neighbour lists of the particles ending a step are built afresh at every substep, so
-their Verlet skin (``floodsph.sph.neighbours``) never has to hold motion, only the growth of
-h within one density solve: the lists take ``LIST_SKIN`` = 0.05 instead of the global step's
-``Numerics.neighbour_skin`` (0.1), and list about 10 % fewer pairs. EA test 4 at 10 m with
-local steps took 124.5, 113.2 and 108.4 s with skins of 0.1, 0.05 and 0.03 (CSI 0.988 and
-0.989 against 0.1, RMSE 1.2 mm; two cores).
-
 Mass is exact (particles keep their mass); linear momentum is conserved only to the order of
 the step, because a pair's forces act on its two particles at their own times.
 """
@@ -46,9 +39,6 @@ from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.forces import friction_factor
-
-LIST_SKIN = 0.05
-"""Relative skin of the neighbour lists under local time stepping (module docstring)."""
 
 
 @njit(parallel=True, cache=True)
