@@ -29,10 +29,10 @@ def test_a_steady_kick_and_friction_settle_at_the_manning_speed_for_any_step(bet
 @pytest.mark.parametrize("stepping", ["global", "local"])
 def test_sheet_flow_down_a_plane_reaches_the_manning_normal_speed(stepping):
     """A 0.2 m sheet on a 1 % slope, n = 0.05, between channel walls: in its middle the flow
-    is uniform and, after 40 s (30 relaxation times), runs at Manning's normal speed
+    is uniform and, after 40 s (six relaxation times u_e / (g S)), runs at Manning's normal speed
     u = d^(2/3) sqrt(S') / n with S' = S / (1 + S^2) (the bed term of floodsph.sph.forces).
     A 25 m deep still pool behind a wall sets the step to 0.11 s. With local steps the sheet
-    takes strides of 8 (0.88 s, beta_e = 0.12), where the point-implicit factor ran 6.1 %
+    takes strides of 8 (0.88 s, beta_e = 0.13), where the point-implicit factor ran 6.1 %
     slow (measured)."""
     slope = 0.01
     pool = [np.array([[1600.0, 0.0], [1600.0, 200.0]])]
