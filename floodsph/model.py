@@ -155,7 +155,6 @@ class FloodModel:
         self.wdist = np.empty(0)
         self._blocked_nl = None
         self._nl_fresh = False  # lists built in this step
-        self._h_median = 1.0  # median h at the start of a big step (local time stepping)
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
         self._settle_seeds()
@@ -231,7 +230,6 @@ class FloodModel:
         for boundary in self.boundaries:
             zone |= boundary.protected(p.x, p.y)
         p.stride[zone] = 1
-        self._h_median = float(np.median(p.h)) if p.n else 1.0
         half = 0.5 * dt_f
         for sub in range(n_sub):
             self._nl_fresh = False
@@ -360,8 +358,7 @@ class FloodModel:
         (``hgrow``, at most ``MAX_SEARCH_GROWTH``), so that a particle whose h keeps growing
         in the solves (a thinning edge) is not held back by its lists step after step
         (:meth:`_solve_density`). ``rows``: list only these particles' neighbours (the
-        near-wall lists still cover every particle, for the drift; local time stepping
-        passes the median h of its big step, which sets the search levels).
+        near-wall lists still cover every particle, for the drift).
         """
         p = self.particles
         nl = getattr(self, "nl", None)
@@ -370,7 +367,7 @@ class FloodModel:
         self._nl_fresh = True
         h_search = p.h * np.clip(p.hgrow, 1.0, MAX_SEARCH_GROWTH)
         self.nl = NeighbourList(p.x, p.y, h_search, skin=self.numerics.neighbour_skin,
-                                rows=rows, h_median=None if rows is None else self._h_median)
+                                rows=rows)
         self.walls_near = self.wall_index.near_lists(p.x, p.y, h_search, self.nl.start,
                                                      self.nl.nbr, self.nl.reach)
 

@@ -250,13 +250,9 @@ class NeighbourList:
         List only these particles' neighbours (among all particles); the other rows are
         empty. Local time stepping (``floodsph.sph.local_steps``) lists the particles that
         end a step. Default: every particle.
-    h_median : float, optional
-        The median h [m] that sets the levels of the search (default: that of ``h``). Any
-        positive value gives the same lists; local time stepping passes the one of its big
-        step, so that the lists of its substeps skip the partition.
     """
 
-    def __init__(self, x, y, h, skin=0.1, rows=None, h_median=None):
+    def __init__(self, x, y, h, skin=0.1, rows=None):
         n = x.shape[0]
         self.skin = skin
         self.complete = rows is None
@@ -270,8 +266,7 @@ class NeighbourList:
             self.nbr = np.zeros(0, dtype=np.int64)
             return
         level = np.empty(n, dtype=np.int64)
-        h_median = float(np.median(h)) if h_median is None else h_median
-        lv_hmax, box = h_levels(x, y, h, LEVEL_BASE * h_median, level)
+        lv_hmax, box = h_levels(x, y, h, LEVEL_BASE * float(np.median(h)), level)
         used = lv_hmax > 0.0
         width = np.where(used, box[:, 2] - box[:, 0], 0.0)
         height = np.where(used, box[:, 3] - box[:, 1], 0.0)
