@@ -59,8 +59,6 @@ class Numerics:
     max_slope : bed slopes steeper than this are limited in the bed term.
     neighbour_skin : relative margin of the neighbour lists.
     reorder_interval : steps between spatial re-sorts of the particle arrays.
-    refinement : the scenario's refinement mode, as a label (the ``refiner`` given to
-        ``FloodModel`` splits and coalesces).
     time_stepping : "global" (one step for all particles) or "local" (each particle at its
         own power-of-two multiple of the finest step, ``floodsph.sph.local_steps``).
     step_levels : K of local stepping: a big step holds 2^K finest steps.
@@ -77,7 +75,6 @@ class Numerics:
     max_slope: float = 1.0
     neighbour_skin: float = 0.1
     reorder_interval: int = 25
-    refinement: str = "none"
     time_stepping: str = "global"
     step_levels: int = 3
 

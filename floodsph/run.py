@@ -191,7 +191,6 @@ def build_model(scenario: Scenario, inputs):
         stabilisation=num.stabilisation.value,
         friction_depth_floor=num.friction_depth_floor_m,
         max_slope=num.max_slope,
-        refinement=num.refinement.value,
         time_stepping=num.time_stepping.value,
         step_levels=num.step_levels,
     )

@@ -22,8 +22,9 @@ Saitoh & Makino, ApJ 697 (2009) L99, with their factor 4 tightened to 2), so tha
 particle next to a fast one is updated often enough to feel a wave arriving within a big step.
 Particles in an open boundary's zone (an inflow's buffer, open edges) take stride 1.
 
-K = ``Numerics.step_levels`` = 3 by default: EA test 4 at 5 m (README) took 680, 602 and
-624 s with K = 2, 3 and 4 on two cores, with the same maps (CSI 0.993, 0.992 and 0.990
+K = ``Numerics.step_levels`` = 3 by default: EA test 4 at 5 m took 680, 602 and
+624 s with K = 2, 3 and 4 on two cores (commit `91a6063`, before the implicit friction;
+609 s with K = 3 since), with the same maps (CSI 0.993, 0.992 and 0.990
 against the global step); a larger K saves synchronisations but adds updates.
 
 Mass is exact (particles keep their mass); linear momentum is conserved only to the order of
