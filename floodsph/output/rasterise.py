@@ -174,14 +174,21 @@ def rasterise(grid, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT):
 
 def _shepard(sums, min_support: float, shape):
     """(d, u, v, support) from kernel sums (n, 4): NaN where the support is short (or 0)."""
-    support = sums[:, 0]
-    ok = (support >= min_support) & (support > 0.0)
-    out = []
-    for c in (1, 2, 3):
-        f = np.full(support.shape, np.nan)
-        f[ok] = sums[ok, c] / support[ok]
-        out.append(f.reshape(shape))
-    return out[0], out[1], out[2], support.reshape(shape)
+    fields = np.empty((3, sums.shape[0]))
+    shepard_divide(sums, min_support, fields)
+    return (fields[0].reshape(shape), fields[1].reshape(shape), fields[2].reshape(shape),
+            sums[:, 0].reshape(shape))
+
+
+@njit(parallel=True, cache=True)
+def shepard_divide(sums, min_support, fields):
+    """fields[c, k] = sums[k, c + 1] / sums[k, 0] (c = 0, 1, 2: d, u, v) where the kernel sum
+    S = sums[k, 0] is at least ``min_support`` and positive; NaN elsewhere."""
+    for k in prange(sums.shape[0]):
+        support = sums[k, 0]
+        ok = support >= min_support and support > 0.0
+        for c in range(3):
+            fields[c, k] = sums[k, c + 1] / support if ok else np.nan
 
 
 @njit(cache=True)
@@ -247,16 +254,22 @@ def grid_sums(xc, yc, x, y, h, vol, d, u, v, band_start, band_items, band_rows, 
                 yj = y[j]
                 hj = h[j]
                 reach = 2.0 * hj
+                reach2 = reach * reach
+                inv_h = 1.0 / hj
+                w_j = vol[j] * inv_h * inv_h  # W(r, h) = W(r / h, 1) / h^2
+                dj = d[j]
+                uj = u[j]
+                vj = v[j]
                 lo, hi = _span(yj, reach, yc[0], dy, ny)
                 c_lo, c_hi = _span(xj, reach, xc[0], dx, nx)
                 for r in range(max(lo, r_first), min(hi, r_last) + 1):
                     ry = yc[r] - yj
                     for col in range(c_lo, c_hi + 1):
                         rx = xc[col] - xj
-                        q = math.sqrt(rx * rx + ry * ry)
-                        if q < reach:
-                            w = vol[j] * w_cubic(q, hj)
+                        q2 = rx * rx + ry * ry
+                        if q2 < reach2:
+                            w = w_j * w_cubic(math.sqrt(q2) * inv_h, 1.0)
                             sums[r, col, 0] += w
-                            sums[r, col, 1] += w * d[j]
-                            sums[r, col, 2] += w * u[j]
-                            sums[r, col, 3] += w * v[j]
+                            sums[r, col, 1] += w * dj
+                            sums[r, col, 2] += w * uj
+                            sums[r, col, 3] += w * vj
