@@ -228,9 +228,12 @@ class FloodModel:
             zone |= boundary.protected(p.x, p.y)
         p.stride[zone] = 1
         half = 0.5 * dt_f
+        end = np.arange(p.n, dtype=np.int64)  # every particle's step begins at finest step 0
         for sub in range(n_sub):
             self._nl_fresh = False
-            begin = local_steps.step_ends(p.stride, sub)
+            # the steps that end at finest step sub begin anew: no particle has been added or
+            # removed since (the boundaries do that in the drift, and refinement at the end)
+            begin = end
             local_steps.kick(begin, p.stride, half, p.u, p.v, p.ax, p.ay)
             self._move(dt_f)
             p.stride[p.stride == 0] = 1  # water that entered in this substep: finest stride
