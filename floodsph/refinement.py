@@ -38,9 +38,9 @@ which (no_merge_steps later, away from walls, fronts and bores) merge pairwise b
 two or three particles, not seven; a merged pair stays below 2 area_min < area_max, so it
 does not split again at once (the hysteresis). With these defaults
 ``workflows/refinement_benchmark.py`` measures (README, one thread) 3.6 times the speed of
-splitting alone on the sample valley and 4.6 times on Malpasset at 20 m, with max-depth maps
-that agree to CSI 0.993 and 0.956; area_min = 0.2 (the notes' A_max / 10) merged so rarely
-that it was no faster than splitting alone.
+splitting alone on the sample valley and 4.2 times on Malpasset at 20 m (3.75 times with local
+time steps), with max-depth maps that agree to CSI 0.993 and 0.956 (0.960); area_min = 0.2
+(the notes' A_max / 10) merged so rarely that it was no faster than splitting alone.
 d_min = 0.01 m is the default wet threshold of the maps and the friction depth floor: water
 thinner than that is invisible on every output and dominated by the friction floor, and
 refining it would only add particles.
