@@ -242,8 +242,10 @@ def test_ea4_scenario_and_hydrograph_written_to_the_contract(tmp_path):
 
 
 @needs_ea4
-@pytest.mark.parametrize("time_stepping", ["global", "local"])
-def test_ea4_short_run_injects_the_hydrograph_volume(tmp_path, time_stepping):
+@pytest.mark.parametrize("time_stepping, refinement", [("global", "split+coalesce"),
+                                                        ("local", "split+coalesce"),
+                                                        ("local", "none")])
+def test_ea4_short_run_injects_the_hydrograph_volume(tmp_path, time_stepping, refinement):
     """700 s on the 10 m DEM: 400 s of inflow, 485 m3, nowhere near the points 400 m away.
 
     The inflow injects whole rows of particles: the injected volume follows the hydrograph
@@ -253,10 +255,14 @@ def test_ea4_short_run_injects_the_hydrograph_volume(tmp_path, time_stepping):
     """
     out = tmp_path / "ea4"
     argv = ["--end-time", "700", "--dem-cell", "10", "--threads", "1", "--out", str(out),
-            "--time-stepping", time_stepping]
+            "--time-stepping", time_stepping, "--refinement", refinement]
     assert ea4.main(argv) == 0
     with open(out / "run" / "run.json") as f:
-        assert json.load(f)["scenario"]["numerics"]["time_stepping"] == time_stepping
+        manifest = json.load(f)
+    assert manifest["scenario"]["numerics"]["time_stepping"] == time_stepping
+    assert manifest["scenario"]["numerics"]["refinement"] == refinement
+    if refinement == "none":
+        assert manifest["splits"] == 0 and manifest["merges"] == 0
     with open(out / "ea4_volume.csv", newline="") as f:
         (balance,) = list(csv.DictReader(f))
     assert float(balance["hydrograph_volume_m3"]) == pytest.approx(_ramp_volume(700.0), rel=1e-5)

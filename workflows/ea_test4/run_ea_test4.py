@@ -22,7 +22,8 @@ DEM, which lies outside the repository), the run folder ``run/``, and the result
   volume against the hydrograph integral).
 
 Usage: ``python workflows/ea_test4/run_ea_test4.py [--end-time 18000] [--dem-cell 5]
-[--spacing 5] [--threads N] [--time-stepping global|local] [--out DIR] [--overwrite]``
+[--spacing 5] [--threads N] [--time-stepping global|local]
+[--refinement split+coalesce|split|none] [--out DIR] [--overwrite]``
 """
 
 from __future__ import annotations
@@ -76,10 +77,12 @@ def read_points(folder: Path) -> list[tuple[str, float, float]]:
 
 
 def write_inputs(folder: Path, out: Path, end_time: float, dem_cell: int,
-                 spacing: float, time_stepping: str = "global") -> Path:
+                 spacing: float, time_stepping: str = "global",
+                 refinement: str = "split+coalesce") -> Path:
     """Hydrograph CSV, gauge CSV and the scenario TOML in ``out``; returns the scenario path.
 
-    ``time_stepping`` is ``numerics.time_stepping`` ("global" or "local")."""
+    ``time_stepping`` is ``numerics.time_stepping`` ("global" or "local"), ``refinement``
+    ``numerics.refinement`` ("split+coalesce", "split" or "none")."""
     from floodsph.hydrograph import read_hydrograph, write_hydrograph_csv
     from floodsph.toml_writer import dumps
 
@@ -102,7 +105,8 @@ def write_inputs(folder: Path, out: Path, end_time: float, dem_cell: int,
         "inflows": [{"line": [list(p) for p in INLET], "hydrograph": "ea4_hydrograph.csv",
                      "direction": list(INLET_DIRECTION)}],
         "gauges": {"file": "ea4_gauges.csv", "interval_s": GAUGE_INTERVAL_S},
-        "numerics": {"particle_spacing_m": spacing, "time_stepping": time_stepping},
+        "numerics": {"particle_spacing_m": spacing, "time_stepping": time_stepping,
+                     "refinement": refinement},
         "output": {"resolution_m": float(dem_cell), "wet_threshold_m": WET_THRESHOLD_M},
     }
     path = out / "ea_test4.toml"
@@ -240,6 +244,9 @@ def main(argv=None) -> int:
     parser.add_argument("--time-stepping", choices=("global", "local"), default="global",
                         help="numerics.time_stepping: one step for all particles, or each "
                              "at its own")
+    parser.add_argument("--refinement", choices=("split+coalesce", "split", "none"),
+                        default="split+coalesce",
+                        help="numerics.refinement: particle splitting and coalescing")
     args = parser.parse_args(argv)
 
     folder = data_folder()
@@ -255,7 +262,8 @@ def main(argv=None) -> int:
     out = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
     path = write_inputs(folder, out, args.end_time, args.dem_cell,
-                        args.spacing or float(args.dem_cell), args.time_stepping)
+                        args.spacing or float(args.dem_cell), args.time_stepping,
+                        args.refinement)
     run = out / "run"
     manifest = run_scenario(load_scenario(path), out_dir=run, overwrite=args.overwrite,
                             max_steps=args.max_steps, threads=args.threads)
