@@ -70,6 +70,32 @@ def test_neighbour_lists_equal_kdtree_with_h_spread_over_many_levels():
     assert _listed_pairs(nl, n) == _reference_pairs(x, y, h)
 
 
+@pytest.mark.parametrize("capacity", [None, 3])
+def test_lists_of_some_rows_equal_kdtree_and_survive_undersized_buffers(monkeypatch, capacity):
+    """Lists for a subset of rows (local time stepping) are exact for those rows and empty
+    for the others. With the build's per-chunk buffers forced far too small (``capacity``
+    slots), every chunk overflows, is counted and searched again: the same lists, in the
+    same order."""
+    from floodsph.sph import neighbours
+
+    rng = np.random.default_rng(13)
+    n = 5000
+    x, y = rng.uniform(0, 100, n), rng.uniform(0, 60, n)
+    h = rng.uniform(0.4, 1.2, n)
+    h[rng.random(n) < 0.02] = 6.0
+    rows = np.sort(rng.choice(n, 2500, replace=False)).astype(np.int64)
+    sized = NeighbourList(x, y, h, skin=0.0, rows=rows)
+    if capacity is not None:
+        monkeypatch.setattr(neighbours, "_chunk_capacity",
+                            lambda args, r: np.full(-(-r.shape[0] // neighbours.CHUNK),
+                                                    capacity, dtype=np.int64))
+    nl = NeighbourList(x, y, h, skin=0.0, rows=rows)
+    mine = set(rows.tolist())
+    assert _listed_pairs(nl, n) == {(i, j) for i, j in _reference_pairs(x, y, h) if i in mine}
+    np.testing.assert_array_equal(nl.start, sized.start)
+    np.testing.assert_array_equal(nl.nbr, sized.nbr)
+
+
 def test_skin_keeps_list_valid_until_h_grows_past_it():
     rng = np.random.default_rng(3)
     x, y = rng.uniform(0, 50, 2000), rng.uniform(0, 50, 2000)

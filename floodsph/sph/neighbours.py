@@ -11,6 +11,11 @@ particle searches the 3 x 3 cells around it on every level within its reach (mor
 where its own h is larger); the candidates of a row of cells are contiguous in cell order.
 The result is exact for any mix of h at a cost set by the local particle density.
 
+The CSR lists are written in one search pass: chunks of ``CHUNK`` rows, one task each, write
+their rows' neighbours into buffers sized from a sample of the rows' counts, and the buffers
+are then copied into place; a chunk whose buffer is too small is counted and searched again.
+(A count pass followed by a fill pass searched every row twice, a third of a build's time.)
+
 The lists are Verlet lists (Verlet 1967; Allen & Tildesley, Computer Simulation of Liquids,
 2nd ed. 2017, section 5.3): built with the relative ``skin`` on the reach,
 R = 2 (1 + skin) max(h_i, h_j), they stay exact while particles move and h grows a little
@@ -28,6 +33,10 @@ from numba import njit, prange
 
 LEVEL_BASE = 1.25
 """Level 0 of the search holds the particles with h <= LEVEL_BASE median(h)."""
+CHUNK = 1024
+"""Rows per task of the parallel list build."""
+SAMPLE_STRIDE = 32
+"""Every SAMPLE_STRIDE-th row is counted first, to size the build's buffers."""
 
 
 @njit(parallel=True, cache=True)
@@ -137,15 +146,18 @@ def _level_cell_ids(x, y, level, box, lv_cell, lv_ncx, lv_ncy, lv_off, out):
 def _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
             lv_hmax, reach, buf, fill):
     """Neighbours of particle i, itself included: their number and, if ``fill``, their
-    indices in ``buf[:number]`` (``buf`` holds one slot more than the number).
+    indices in ``buf[:number]`` when ``buf`` holds one slot more than the number.
 
     ``xs, ys, hs`` are x, y, h in cell order (``xs[s] = x[order[s]]``): the candidates of a
     row of adjacent cells are one contiguous run. Each candidate is written unconditionally
-    and kept by advancing the count, so the loop has no data-dependent jump.
+    and kept by advancing the count, so the loop has no data-dependent jump; a shorter
+    ``buf`` takes the writes past its end in its last slot (the caller sees that the number
+    does not fit, and searches again).
     """
     xi = x[i]
     yi = y[i]
     hi = h[i]
+    last = buf.shape[0] - 1
     k = 0
     for lv in range(lv_cell.shape[0]):
         cell = lv_cell[lv]
@@ -168,45 +180,84 @@ def _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_
                 dy = ys[s] - yi
                 r = reach * max(hi, hs[s])
                 if fill:
-                    buf[k] = order[s]
+                    buf[min(k, last)] = order[s]
                 k += dx * dx + dy * dy < r * r
     return k
 
 
 @njit(parallel=True, cache=True)
 def _count(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
-           lv_hmax, reach, rows, nbr_start):
-    """Number of neighbours of each particle in ``rows`` (itself excluded) into
-    ``nbr_start[i + 1]``."""
+           lv_hmax, reach, rows, counts):
+    """Number of neighbours of each particle ``rows[k]`` (itself excluded) into
+    ``counts[k]``."""
     buf = np.zeros(0, dtype=np.int64)
     for k in prange(rows.shape[0]):
-        i = rows[k]
-        nbr_start[i + 1] = _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell,
-                                   lv_ncx, lv_ncy, lv_off, lv_hmax, reach, buf, False) - 1
+        counts[k] = _search(rows[k], x, y, h, xs, ys, hs, order, cell_start, box, lv_cell,
+                            lv_ncx, lv_ncy, lv_off, lv_hmax, reach, buf, False) - 1
 
 
 @njit(parallel=True, cache=True)
-def _fill(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
-          lv_hmax, reach, rows, nbr_start, chunk, nbr):
-    """Write the neighbours of each particle in ``rows`` into ``nbr`` (CSR by ``nbr_start``).
+def _gather(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
+            lv_hmax, reach, rows, chunk, chunks, base, counts, buf, used):
+    """Neighbours of the rows of the listed chunks, in one search pass.
 
-    Parallel over chunks of ``chunk`` rows, each with its own search buffer.
+    Chunk ``c = chunks[k]`` holds the rows ``rows[c chunk:(c + 1) chunk]``; their neighbours
+    (each row's in search order, itself left out) go one row after another into
+    ``buf[base[k]:base[k + 1]]``, the number of row r's into ``counts[r]``, and the number
+    written into ``used[k]``, or -1 where a row and its spare slot did not fit (the chunk
+    stops there). Parallel over the listed chunks, each writing its own range.
     """
-    n = rows.shape[0]
-    width = 0
-    for i in range(x.shape[0]):
-        width = max(width, nbr_start[i + 1] - nbr_start[i])
-    for c in prange((n + chunk - 1) // chunk):
-        buf = np.empty(width + 2, dtype=np.int64)
-        for r in range(c * chunk, min(n, (c + 1) * chunk)):
+    nrows = rows.shape[0]
+    for k in prange(chunks.shape[0]):
+        c = chunks[k]
+        pos = base[k]
+        end = base[k + 1]
+        for r in range(c * chunk, min(nrows, (c + 1) * chunk)):
             i = rows[r]
-            k = _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx,
-                        lv_ncy, lv_off, lv_hmax, reach, buf, True)
-            pos = nbr_start[i]
-            for q in range(k):
-                if buf[q] != i:
-                    nbr[pos] = buf[q]
-                    pos += 1
+            found = _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx,
+                            lv_ncy, lv_off, lv_hmax, reach, buf[pos:end], True)
+            if found >= end - pos:  # the row and its spare slot need found + 1
+                pos = -1
+                break
+            own = pos
+            while buf[own] != i:
+                own += 1
+            for q in range(own, pos + found - 1):  # leave itself out, keeping the order
+                buf[q] = buf[q + 1]
+            counts[r] = found - 1
+            pos += found - 1
+        used[k] = pos if pos < 0 else pos - base[k]
+
+
+@njit(parallel=True, cache=True)
+def _scatter(rows, chunk, chunks, base, counts, buf, nbr_start, nbr):
+    """Copy the neighbours that :func:`_gather` left in ``buf`` (chunk ``chunks[k]``'s from
+    ``base[k]``) into their CSR place ``nbr[nbr_start[i]:nbr_start[i + 1]]``."""
+    nrows = rows.shape[0]
+    for k in prange(chunks.shape[0]):
+        c = chunks[k]
+        src = base[k]
+        for r in range(c * chunk, min(nrows, (c + 1) * chunk)):
+            dst = nbr_start[rows[r]]
+            for q in range(counts[r]):
+                nbr[dst + q] = buf[src + q]
+            src += counts[r]
+
+
+def _chunk_capacity(args, rows: np.ndarray) -> np.ndarray:
+    """Slots for each chunk of ``CHUNK`` rows in :func:`_gather`, from the neighbour counts of
+    every ``SAMPLE_STRIDE``-th row: 1.5 times the chunk's sampled mean per row times its
+    rows, plus twice its sampled largest count and a margin, so that a chunk seldom has to be
+    searched again."""
+    sample = rows[::SAMPLE_STRIDE]
+    if sample.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    found = np.empty(sample.shape[0], dtype=np.int64)
+    _count(*args[:-1], sample, found)
+    first = np.arange(0, sample.shape[0], CHUNK // SAMPLE_STRIDE)
+    mean = np.add.reduceat(found, first) / np.diff(np.append(first, sample.shape[0]))
+    size = np.minimum(rows.shape[0] - first * SAMPLE_STRIDE, CHUNK)
+    return (1.5 * size * mean + 2.0 * np.maximum.reduceat(found, first) + 64.0).astype(np.int64)
 
 
 @njit(parallel=True, cache=True)
@@ -232,6 +283,46 @@ def _motion(x, y, h, x_b, y_b, h_b):
         grow = max(grow, h[i] / h_b[i])
         move = max(move, math.hypot(x[i] - x_b[i], y[i] - y_b[i]) / h_b[i])
     return grow, move
+
+
+def _lists(args, rows: np.ndarray, nbr_start: np.ndarray) -> np.ndarray:
+    """The CSR lists of ``rows`` (``args``: the search arguments of :func:`_gather`): fills
+    ``nbr_start`` (zeros on entry) and returns ``nbr``.
+
+    One search pass (:func:`_gather`) into per-chunk buffers sized by
+    :func:`_chunk_capacity`; a chunk that does not fit is counted exactly and searched again
+    into a buffer of its size; the buffers are then copied into place (:func:`_scatter`).
+    """
+    counts = np.empty(rows.shape[0], dtype=np.int64)
+    nchunk = (rows.shape[0] + CHUNK - 1) // CHUNK
+    chunks = np.arange(nchunk, dtype=np.int64)
+    base = np.zeros(nchunk + 1, dtype=np.int64)
+    np.cumsum(_chunk_capacity(args, rows), out=base[1:])
+    buf = np.empty(base[-1], dtype=np.int64)
+    used = np.empty(nchunk, dtype=np.int64)
+    _gather(*args, CHUNK, chunks, base, counts, buf, used)
+    done = used >= 0
+    passes = [(chunks[done], base[:-1][done], buf)]
+    redo = chunks[~done]
+    if redo.size:
+        again = np.concatenate([rows[c * CHUNK:(c + 1) * CHUNK] for c in redo])
+        found = np.empty(again.shape[0], dtype=np.int64)
+        _count(*args[:-1], again, found)
+        first = np.append(0, np.cumsum(np.minimum(rows.shape[0] - redo * CHUNK, CHUNK))[:-1])
+        base2 = np.zeros(redo.size + 1, dtype=np.int64)
+        np.cumsum(np.add.reduceat(found, first) + 2, out=base2[1:])
+        buf2 = np.empty(base2[-1], dtype=np.int64)
+        used2 = np.empty(redo.size, dtype=np.int64)
+        _gather(*args, CHUNK, redo, base2, counts, buf2, used2)
+        if (used2 < 0).any():
+            raise RuntimeError("neighbour lists: a chunk overflowed its exact size")
+        passes.append((redo, base2[:-1], buf2))
+    nbr_start[rows + 1] = counts
+    np.cumsum(nbr_start, out=nbr_start)
+    nbr = np.empty(nbr_start[-1], dtype=np.int64)
+    for listed, start, buffer in passes:
+        _scatter(rows, CHUNK, listed, start, counts, buffer, nbr_start, nbr)
+    return nbr
 
 
 class NeighbourList:
@@ -284,10 +375,7 @@ class NeighbourList:
         cell_start, order = counting_sort(cid, int(lv_off[-1]), _chunks(n))
         args = (x, y, h, x[order], y[order], h[order], order, cell_start, box, lv_cell, lv_ncx,
                 lv_ncy, lv_off, lv_hmax, self.reach, self.rows)
-        _count(*args, self.start)
-        np.cumsum(self.start, out=self.start)
-        self.nbr = np.empty(self.start[-1], dtype=np.int64)
-        _fill(*args, self.start, 1024, self.nbr)
+        self.nbr = _lists(args, self.rows, self.start)
 
     def still_valid(self, x, y, h) -> bool:
         """True while the list still holds every pair with r_ij < 2 max(h_i, h_j).
