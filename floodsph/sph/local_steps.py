@@ -24,8 +24,9 @@ Particles in an open boundary's zone (an inflow's buffer, open edges) take strid
 
 K = ``Numerics.step_levels`` = 3 by default: EA test 4 at 5 m took 680, 602 and
 624 s with K = 2, 3 and 4 on two cores (commit `91a6063`, before the implicit friction;
-with K = 3, 609 s at `e2dbceb` and 604 s at `cf44f63`), with the same maps (CSI 0.993,
-0.992 and 0.990 against the global step); a larger K saves synchronisations but adds updates.
+with K = 3, 609 s at `e2dbceb`, 604 s at `cf44f63` and 570 s at `5006322`), with the same
+maps (CSI 0.993, 0.992 and 0.990 against the global step); a larger K saves synchronisations
+but adds updates.
 
 Mass is exact (particles keep their mass); linear momentum is conserved only to the order of
 the step, because a pair's forces act on its two particles at their own times.
