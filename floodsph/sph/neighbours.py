@@ -203,9 +203,9 @@ def _gather(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy
 
     Chunk ``c = chunks[k]`` holds the rows ``rows[c chunk:(c + 1) chunk]``; their neighbours
     (each row's in search order, itself left out) go one row after another into
-    ``buf[base[k]:base[k + 1]]``, the number of row r's into ``counts[r]``, and the number
-    written into ``used[k]``, or -1 where a row and its spare slot did not fit (the chunk
-    stops there). Parallel over the listed chunks, each writing its own range.
+    ``buf[base[k]:base[k + 1]]``, row r's number of neighbours into ``counts[r]``, and the
+    number written into ``used[k]``, or -1 where a row and its spare slot did not fit (the
+    chunk stops there). Parallel over the listed chunks, each writing its own range.
     """
     nrows = rows.shape[0]
     for k in prange(chunks.shape[0]):
