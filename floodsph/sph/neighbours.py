@@ -198,26 +198,27 @@ def _count(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy,
 
 @njit(parallel=True, cache=True)
 def _gather(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy, lv_off,
-            lv_hmax, reach, rows, chunk, chunks, base, counts, buf, used):
+            lv_hmax, reach, rows, chunk, chunks, base, counts, buf, fits):
     """Neighbours of the rows of the listed chunks, in one search pass.
 
     Chunk ``c = chunks[k]`` holds the rows ``rows[c chunk:(c + 1) chunk]``; their neighbours
     (each row's in search order, itself left out) go one row after another into
-    ``buf[base[k]:base[k + 1]]``, row r's number of neighbours into ``counts[r]``, and the
-    number written into ``used[k]``, or -1 where a row and its spare slot did not fit (the
-    chunk stops there). Parallel over the listed chunks, each writing its own range.
+    ``buf[base[k]:base[k + 1]]`` and row r's number of neighbours into ``counts[r]``;
+    ``fits[k]`` is False where a row and its spare slot did not fit (the chunk stops there).
+    Parallel over the listed chunks, each writing its own range.
     """
     nrows = rows.shape[0]
     for k in prange(chunks.shape[0]):
         c = chunks[k]
         pos = base[k]
         end = base[k + 1]
+        fits[k] = True
         for r in range(c * chunk, min(nrows, (c + 1) * chunk)):
             i = rows[r]
             found = _search(i, x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx,
                             lv_ncy, lv_off, lv_hmax, reach, buf[pos:end], True)
             if found >= end - pos:  # the row and its spare slot need found + 1
-                pos = -1
+                fits[k] = False
                 break
             own = pos
             while buf[own] != i:
@@ -226,7 +227,6 @@ def _gather(x, y, h, xs, ys, hs, order, cell_start, box, lv_cell, lv_ncx, lv_ncy
                 buf[q] = buf[q + 1]
             counts[r] = found - 1
             pos += found - 1
-        used[k] = pos if pos < 0 else pos - base[k]
 
 
 @njit(parallel=True, cache=True)
@@ -299,9 +299,8 @@ def _lists(args, rows: np.ndarray, nbr_start: np.ndarray) -> np.ndarray:
     base = np.zeros(nchunk + 1, dtype=np.int64)
     np.cumsum(_chunk_capacity(args, rows), out=base[1:])
     buf = np.empty(base[-1], dtype=np.int64)
-    used = np.empty(nchunk, dtype=np.int64)
-    _gather(*args, CHUNK, chunks, base, counts, buf, used)
-    done = used >= 0
+    done = np.empty(nchunk, dtype=np.bool_)
+    _gather(*args, CHUNK, chunks, base, counts, buf, done)
     passes = [(chunks[done], base[:-1][done], buf)]
     redo = chunks[~done]
     if redo.size:
@@ -312,9 +311,9 @@ def _lists(args, rows: np.ndarray, nbr_start: np.ndarray) -> np.ndarray:
         base2 = np.zeros(redo.size + 1, dtype=np.int64)
         np.cumsum(np.add.reduceat(found, first) + 2, out=base2[1:])
         buf2 = np.empty(base2[-1], dtype=np.int64)
-        used2 = np.empty(redo.size, dtype=np.int64)
-        _gather(*args, CHUNK, redo, base2, counts, buf2, used2)
-        if (used2 < 0).any():
+        fits = np.empty(redo.size, dtype=np.bool_)
+        _gather(*args, CHUNK, redo, base2, counts, buf2, fits)
+        if not fits.all():
             raise RuntimeError("neighbour lists: a chunk overflowed its exact size")
         passes.append((redo, base2[:-1], buf2))
     nbr_start[rows + 1] = counts

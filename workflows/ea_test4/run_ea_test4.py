@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from floodsph.output.tables import write_csv
+from floodsph.refinement import MODES as REFINEMENT_MODES
 
 REPO = Path(__file__).resolve().parents[2]
 DEM_NAMES = {5: "ea4_dem_5m.asc", 10: "ea4_dem_10m.asc"}
@@ -78,11 +79,11 @@ def read_points(folder: Path) -> list[tuple[str, float, float]]:
 
 def write_inputs(folder: Path, out: Path, end_time: float, dem_cell: int,
                  spacing: float, time_stepping: str = "global",
-                 refinement: str = "split+coalesce") -> Path:
+                 refinement: str | None = None) -> Path:
     """Hydrograph CSV, gauge CSV and the scenario TOML in ``out``; returns the scenario path.
 
     ``time_stepping`` is ``numerics.time_stepping`` ("global" or "local"), ``refinement``
-    ``numerics.refinement`` ("split+coalesce", "split" or "none")."""
+    ``numerics.refinement`` (None: floodsph's default)."""
     from floodsph.hydrograph import read_hydrograph, write_hydrograph_csv
     from floodsph.toml_writer import dumps
 
@@ -105,10 +106,11 @@ def write_inputs(folder: Path, out: Path, end_time: float, dem_cell: int,
         "inflows": [{"line": [list(p) for p in INLET], "hydrograph": "ea4_hydrograph.csv",
                      "direction": list(INLET_DIRECTION)}],
         "gauges": {"file": "ea4_gauges.csv", "interval_s": GAUGE_INTERVAL_S},
-        "numerics": {"particle_spacing_m": spacing, "time_stepping": time_stepping,
-                     "refinement": refinement},
+        "numerics": {"particle_spacing_m": spacing, "time_stepping": time_stepping},
         "output": {"resolution_m": float(dem_cell), "wet_threshold_m": WET_THRESHOLD_M},
     }
+    if refinement is not None:
+        scenario["numerics"]["refinement"] = refinement
     path = out / "ea_test4.toml"
     path.write_text(dumps(scenario), encoding="utf-8")
     return path
@@ -244,9 +246,8 @@ def main(argv=None) -> int:
     parser.add_argument("--time-stepping", choices=("global", "local"), default="global",
                         help="numerics.time_stepping: one step for all particles, or each "
                              "at its own")
-    parser.add_argument("--refinement", choices=("split+coalesce", "split", "none"),
-                        default="split+coalesce",
-                        help="numerics.refinement: particle splitting and coalescing")
+    parser.add_argument("--refinement", choices=REFINEMENT_MODES, default=None,
+                        help="numerics.refinement (default: floodsph's, split+coalesce)")
     args = parser.parse_args(argv)
 
     folder = data_folder()
