@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from floodsph.boundaries.junctions import split_at_junctions
 from floodsph.boundaries.nodata_walls import nodata_polylines, settle_seeds
 from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
 from floodsph.boundaries.open_edges import OpenEdges
@@ -137,7 +138,8 @@ class FloodModel:
         if closed_edges is not False:
             segs.append(wallmod.segments_from_polylines(
                 nodata_polylines(terrain.valid, terrain.dx, terrain.dy, openings)))
-        self.seg = cut_openings(np.concatenate(segs), openings, 1e-6 * numerics.spacing)
+        tol = 1e-6 * numerics.spacing
+        self.seg = split_at_junctions(cut_openings(np.concatenate(segs), openings, tol), tol)
         self.wall_index = wallmod.WallIndex(
             self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=2.0 * h0)
         self.t = 0.0
