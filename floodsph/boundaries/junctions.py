@@ -20,10 +20,12 @@ from numba import njit
 
 
 @njit(cache=True)
-def _cut_points(seg, tol, fill, at, point):
+def _cut_points(seg, order, tol, fill, at, point):
     """Count (``fill`` False) or list the cuts of each segment: returns the count per segment.
 
-    For segments a and b whose bounding boxes overlap (within ``tol``):
+    ``order`` sorts the segments by their smallest x, so that the pairs of a are swept only
+    until a later segment starts beyond a's largest x. For segments a and b whose bounding
+    boxes overlap (within ``tol``):
 
     * an end point of b within ``tol`` [m] of a's interior (more than ``tol`` from a's ends)
       cuts a at that end point (a T);
@@ -35,12 +37,15 @@ def _cut_points(seg, tol, fill, at, point):
     """
     ns = seg.shape[0]
     count = np.zeros(ns, dtype=np.int64)
-    for a in range(ns):
+    for ka in range(ns):
+        a = order[ka]
         ax1, ay1, ax2, ay2 = seg[a, 0], seg[a, 1], seg[a, 2], seg[a, 3]
-        for b in range(a + 1, ns):
+        for kb in range(ka + 1, ns):
+            b = order[kb]
             bx1, by1, bx2, by2 = seg[b, 0], seg[b, 1], seg[b, 2], seg[b, 3]
-            if (max(ax1, ax2) + tol < min(bx1, bx2) or max(bx1, bx2) + tol < min(ax1, ax2)
-                    or max(ay1, ay2) + tol < min(by1, by2)
+            if min(bx1, bx2) > max(ax1, ax2) + tol:
+                break
+            if (max(bx1, bx2) + tol < min(ax1, ax2) or max(ay1, ay2) + tol < min(by1, by2)
                     or max(by1, by2) + tol < min(ay1, ay2)):
                 continue
             touched = False
@@ -103,12 +108,13 @@ def split_at_junctions(seg: np.ndarray, tol: float) -> np.ndarray:
     direction; pieces no longer than ``tol`` are dropped.
     """
     seg = np.ascontiguousarray(seg, dtype=np.float64).reshape(-1, 4)
-    count = _cut_points(seg, tol, False, np.zeros(0, np.int64), np.zeros((0, 2)))
+    order = np.argsort(np.minimum(seg[:, 0], seg[:, 2]), kind="stable")
+    count = _cut_points(seg, order, tol, False, np.zeros(0, np.int64), np.zeros((0, 2)))
     if not count.any():
         return seg
     at = np.concatenate([[0], np.cumsum(count)[:-1]])
     point = np.empty((int(count.sum()), 2))
-    _cut_points(seg, tol, True, at, point)
+    _cut_points(seg, order, tol, True, at, point)
     pieces = []
     for s, (x1, y1, x2, y2) in enumerate(seg):
         cuts = point[at[s]:at[s] + count[s]]
