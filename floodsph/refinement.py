@@ -17,7 +17,11 @@ Criteria (thresholds are multiples of the initial particle area A0 = spacing^2):
   larger of h and the merged particle's lattice h, kappa sqrt(2 A)) or in an open boundary's
   zone (``FloodModel.protected``), neither was born (split, merge or inflow) in the last
   ``no_merge_steps`` steps, |d_a - d_b| <= depth_jump max(d_a, d_b) and
-  |v_a - v_b| <= speed_jump sqrt(g max(d_a, d_b)) (no merging across fronts and bores).
+  |v_a - v_b| <= speed_jump sqrt(g max(d_a, d_b)) (no merging across fronts and bores);
+* absorb a small candidate t (A_t < SMALL_FRACTION area_min A0) that found no such pair into
+  its nearest particle b of any size, when A_t + A_b < 2 area_min A0, b is settled and
+  unprotected, closer than h_b and without a velocity jump (:meth:`Refiner._absorptions`):
+  a lone small particle in deep, fast water otherwise sets the global time step.
 
 New particles (method notes 4.3 and 5): daughters take h = 0.9 h_p, merged particles the h_M
 of ``floodsph.sph.refine.merged_h`` (floored at the lattice value kappa sqrt(A_M), see there).
@@ -37,10 +41,11 @@ which (no_merge_steps later, away from walls, fronts and bores) merge pairwise b
 0.55 - 0.7 A0 and then 1.1 - 1.4 A0, so that the seven daughters of a thinning sheet become
 two or three particles, not seven; a merged pair stays below 2 area_min < area_max, so it
 does not split again at once (the hysteresis). With these defaults
-``workflows/refinement_benchmark.py`` measures (README, one thread) 3.6 times the speed of
-splitting alone on the sample valley and 4.2 times on Malpasset at 20 m (3.75 times with local
-time steps), with max-depth maps that agree to CSI 0.993 and 0.956 (0.960); area_min = 0.2
-(the notes' A_max / 10) merged so rarely that it was no faster than splitting alone.
+``workflows/refinement_benchmark.py`` measures (README, one thread) 4.2 times the speed of
+splitting alone on the sample valley and 8.6-9.0 times on Malpasset at 20 m (4.6 times before
+small particles were absorbed), with max-depth maps that agree to CSI 0.993 and 0.954;
+area_min = 0.2 (the notes' A_max / 10) merged so rarely that it was no faster than splitting
+alone.
 d_min = 0.01 m is the default wet threshold of the maps and the friction depth floor: water
 thinner than that is invisible on every output and dominated by the friction floor, and
 refining it would only add particles.
@@ -65,6 +70,12 @@ RELAX_RATE = 0.2
 EDGE_ALPHA = 0.8
 """Particles with alpha_i < EDGE_ALPHA 2 rho_i (a kernel support short of neighbours: a wet/dry
 edge) are not relaxed (:func:`relax_smoothing`)."""
+SMALL_FRACTION = 0.25
+"""A merge candidate below SMALL_FRACTION area_min that finds no fellow candidate is absorbed
+by its nearest particle of any size (:meth:`Refiner._absorptions`): its h is half or less of
+an area_min particle's, and such a particle, a shallow seed or a daughter carried into deep,
+fast water, sets the global time step (on Malpasset at 20 m the step-setting particles had h
+of 4-5 m among neighbours of 26 m)."""
 SMOOTHING_EXCESS = 3.0
 """Split particles relax to h = sqrt(3) kappa sqrt(m / rho), not to the lattice value: on the
 coarse Ritter case (tests/test_refine.py) and the first 60 s of Malpasset this beat both no
@@ -253,7 +264,23 @@ class Refiner:
 
     # -- coalescing --------------------------------------------------------------------------
     def merge_pairs(self, model) -> tuple[np.ndarray, np.ndarray]:
-        """Index arrays (a, b) of the particle pairs to merge, a < b (module docstring).
+        """Index arrays (a, b) of the particle pairs to merge (module docstring): the mutual
+        nearest candidates (a < b), then the small candidates left and their absorbers
+        (:meth:`_absorptions`; a is the small one)."""
+        p = model.particles
+        s = self.settings
+        idx = np.flatnonzero((p.m < self.area_min * p.rho)
+                             & (model.steps - p.born >= s.no_merge_steps))
+        if idx.size:  # the wall test covers the support of the merged particle, too
+            reach_h = np.maximum(p.h[idx], model.numerics.kappa
+                                 * np.sqrt(2.0 * p.m[idx] / p.rho[idx]))
+            idx = idx[~model.protected(p.x[idx], p.y[idx], reach_h)]
+        a, b = self._mutual_pairs(p, idx)
+        small_a, small_b = self._absorptions(model, idx, np.concatenate([a, b]))
+        return np.concatenate([a, small_a]), np.concatenate([b, small_b])
+
+    def _mutual_pairs(self, p, idx) -> tuple[np.ndarray, np.ndarray]:
+        """Pairs (a < b) of the candidates ``idx`` that are each other's nearest candidate.
 
         The nearest candidates are searched among the candidates alone, in lists of the pairs
         with r_ab < max(h_a, h_b): that holds every pair that may merge (r_ab < min(h_a, h_b)),
@@ -262,34 +289,83 @@ class Refiner:
         from floodsph.sph import refine
         from floodsph.sph.neighbours import NeighbourList
 
-        p = model.particles
-        s = self.settings
-        empty = np.zeros(0, dtype=np.int64)
-        idx = np.flatnonzero((p.m < self.area_min * p.rho)
-                             & (model.steps - p.born >= s.no_merge_steps))
-        if idx.size >= 2:  # the wall test covers the support of the merged particle, too
-            reach_h = np.maximum(p.h[idx], model.numerics.kappa
-                                 * np.sqrt(2.0 * p.m[idx] / p.rho[idx]))
-            idx = idx[~model.protected(p.x[idx], p.y[idx], reach_h)]
         if idx.size < 2:
-            return empty, empty
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
         x, y = p.x[idx], p.y[idx]
         near = NeighbourList(x, y, 0.5 * p.h[idx], skin=0.0)
         nn = np.empty(idx.size, dtype=np.int64)
-        refine.nearest_candidate(x, y, near.start, near.nbr, np.ones(idx.size, dtype=np.bool_),
-                                 nn)
+        refine.nearest_of(np.arange(idx.size), x, y, near.start, near.nbr,
+                          np.ones(idx.size, dtype=np.bool_), nn)
         a = np.flatnonzero(nn > np.arange(idx.size))
         b = nn[a]
         mutual = nn[b] == a
         a, b = idx[a[mutual]], idx[b[mutual]]
+        r = np.hypot(p.x[a] - p.x[b], p.y[a] - p.y[b])
+        ok = self._smooth_pairs(p, a, b) & (r < np.minimum(p.h[a], p.h[b]))
+        return a[ok], b[ok]
+
+    def _smooth_pairs(self, p, a, b) -> np.ndarray:
+        """True for the pairs (a, b) with no depth or velocity jump between them."""
+        s = self.settings
         d_a, d_b = p.rho[a] / RHO_WATER, p.rho[b] / RHO_WATER
         d_max = np.maximum(d_a, d_b)
         dv = np.hypot(p.u[a] - p.u[b], p.v[a] - p.v[b])
-        r = np.hypot(p.x[a] - p.x[b], p.y[a] - p.y[b])
-        ok = (np.abs(d_a - d_b) <= s.depth_jump * d_max)
-        ok &= dv <= s.speed_jump * np.sqrt(GRAVITY * d_max)
-        ok &= r < np.minimum(p.h[a], p.h[b])
-        return a[ok], b[ok]
+        return ((np.abs(d_a - d_b) <= s.depth_jump * d_max)
+                & (dv <= s.speed_jump * np.sqrt(GRAVITY * d_max)))
+
+    def _absorptions(self, model, cand, paired) -> tuple[np.ndarray, np.ndarray]:
+        """Pairs (t, b) in which a small particle t is absorbed by a larger neighbour b.
+
+        t is a merge candidate left unpaired (``cand`` minus ``paired``) with an area below
+        SMALL_FRACTION area_min, and b its nearest particle that is neither small nor paired;
+        of the small particles with the same b only the closest is absorbed, so no particle is
+        in two merges. b must be settled (born at least ``no_merge_steps`` ago), away from
+        walls and open boundaries (``FloodModel.protected``, over the merged particle's lattice
+        support), with no depth or velocity jump to t, closer than h_b, and A_t + A_b <
+        2 area_min (the merged particle does not split at once). The jump test is on velocity
+        alone, |v_t - v_b| <= speed_jump sqrt(g d_b) (across a bore or a front the speeds
+        differ too): with h below half of its neighbours', t's own summed depth is mostly its
+        self term and its nearest neighbour's, 2.9 m in 1 m of water 0.24 m from a neighbour
+        (``tests/test_refine.py``).
+        """
+        from floodsph.sph import refine
+        from floodsph.sph.neighbours import NeighbourList
+
+        p = model.particles
+        empty = np.zeros(0, dtype=np.int64)
+        small = np.setdiff1d(cand[p.m[cand] < SMALL_FRACTION * self.area_min * p.rho[cand]],
+                             paired)
+        if small.size == 0:
+            return empty, empty
+        n = p.n
+        near = NeighbourList(p.x[:n], p.y[:n], 0.5 * p.h[:n], skin=0.0, rows=small)
+        is_small = np.zeros(n, dtype=np.bool_)
+        is_small[small] = True
+        partner = np.ones(n, dtype=np.bool_)
+        partner[paired] = False
+        partner[small] = False
+        partner &= model.steps - p.born[:n] >= self.settings.no_merge_steps
+        nn = np.full(n, -1, dtype=np.int64)
+        refine.nearest_of(small, p.x, p.y, near.start, near.nbr, partner, nn)
+        t = small[nn[small] >= 0]
+        b = nn[t]
+        # b's nearest small particle must be t: keep, for each b, the closest t
+        r = np.hypot(p.x[t] - p.x[b], p.y[t] - p.y[b])
+        first = np.lexsort((t, r, b))
+        keep = np.ones(first.size, dtype=bool)
+        keep[1:] = b[first[1:]] != b[first[:-1]]
+        t, b, r = t[first[keep]], b[first[keep]], r[first[keep]]
+        dv = np.hypot(p.u[t] - p.u[b], p.v[t] - p.v[b])
+        ok = (dv <= self.settings.speed_jump * np.sqrt(GRAVITY * p.rho[b] / RHO_WATER))
+        ok &= r < p.h[b]
+        ok &= p.m[t] / p.rho[t] + p.m[b] / p.rho[b] < 2.0 * self.area_min
+        t, b = t[ok], b[ok]
+        if t.size:
+            reach_h = np.maximum(p.h[b], model.numerics.kappa
+                                 * np.sqrt((p.m[t] + p.m[b]) / p.rho[b]))
+            clear = ~model.protected(p.x[b], p.y[b], reach_h)
+            t, b = t[clear], b[clear]
+        return t, b
 
     @staticmethod
     def _merged(model, a, b) -> dict | None:

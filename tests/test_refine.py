@@ -202,6 +202,67 @@ def test_merge_keeps_the_depth_at_the_merged_position():
         assert abs(shepard_depth(model, xm[k:k + 1], ym[k:k + 1])[0] / before - 1.0) < 0.05
 
 
+def pond_with_small_particles(fraction, at):
+    """The jittered 1 m pond with extra particles of ``fraction`` of a lattice particle's mass
+    (and h0 = kappa sqrt(fraction) m, the lattice value of their area) at the points ``at``
+    ((k, 2) [m]), moving at (0.2, -0.1) m/s; returns the model and their indices."""
+    base = jittered_pond(1.0)
+    q = base.particles
+    x = np.concatenate([q.x, at[:, 0]])
+    y = np.concatenate([q.y, at[:, 1]])
+    p = particles_with_depth(x, y, np.ones(x.size), 1.0, 1.3)
+    p.m[q.n:] *= fraction
+    p.h[q.n:] = p.h0[q.n:] = 1.3 * math.sqrt(fraction)  # the lattice h of their area
+    p.u[q.n:], p.v[q.n:] = 0.2, -0.1
+    model = FloodModel(base.terrain, p, Numerics(spacing=1.0, kappa=1.3))
+    small = np.flatnonzero(np.isin(model.particles.pid, np.arange(q.n, p.n)))
+    return model, small
+
+
+def test_a_small_particle_among_large_ones_is_absorbed_by_its_nearest():
+    """A particle of a tenth of its neighbours' mass (h about a third of theirs) finds no fellow
+    candidate; it merges into its nearest particle, mass and momentum exact. The depth
+    interpolated at the merged position, 19 % above the pond's before (the small particle's
+    own summed depth is 2.9 m), is then the pond's to 5 %, and the stable step, which the
+    small particles set, grows eightfold."""
+    at = np.array([[10.3, 12.6], [20.4, 8.2]])
+    model, small = pond_with_small_particles(0.1, at)
+    p = model.particles
+    refiner = Refiner(Refinement(area_max=2.0, area_min=0.8, no_merge_steps=0), 1.0)
+    a, b = refiner.merge_pairs(model)  # the lattice's areas are 0.85-1.15: no candidates
+    assert sorted(a) == sorted(small)
+    for t, partner in zip(a, b, strict=True):
+        r = np.hypot(p.x - p.x[t], p.y - p.y[t])
+        r[t] = np.inf
+        assert partner == np.argmin(r)
+    w = p.m[a] / (p.m[a] + p.m[b])
+    xm, ym = w * p.x[a] + (1 - w) * p.x[b], w * p.y[a] + (1 - w) * p.y[b]
+    before = shepard_depth(model, xm, ym)
+    dt0 = model.stable_dt()
+    mass0, mom0, scale = totals(p)
+    assert refiner.execute(model, [], a, b) == (0, 2)
+    mass1, mom1, _ = totals(p)
+    assert abs(mass1 - mass0) <= 1e-12 * mass0
+    assert np.all(np.abs(mom1 - mom0) <= 1e-12 * scale)
+    solve_in_place(model)
+    mean = p.m.sum() / RHO_WATER / 30.0**2  # the pond's volume over its area [m]
+    assert np.all(np.abs(shepard_depth(model, xm, ym) / mean - 1.0) < 0.05)
+    assert np.abs(before / mean - 1.0).max() > 0.15  # the small particle's own depth, 2.9 m
+    assert model.stable_dt() > 4.0 * dt0
+
+
+def test_a_small_particle_is_not_absorbed_where_the_merged_one_would_split():
+    """Absorption keeps the hysteresis: no absorber whose merged area would reach
+    2 area_min (here 0.1 + 1.0 against 2 x 0.5), and none across a velocity jump."""
+    model, small = pond_with_small_particles(0.1, np.array([[10.3, 12.6]]))
+    tight = Refiner(Refinement(area_max=2.0, area_min=0.5, no_merge_steps=0), 1.0)
+    assert tight.merge_pairs(model)[0].size == 0
+    loose = Refiner(Refinement(area_max=2.0, area_min=0.8, no_merge_steps=0), 1.0)
+    assert loose.merge_pairs(model)[0].tolist() == small.tolist()
+    model.particles.u[small] = 1.6  # against 0.5 sqrt(g d) = 1.57 m/s in 1 m of still water
+    assert loose.merge_pairs(model)[0].size == 0
+
+
 def test_no_merge_near_walls_across_jumps_or_of_newborns():
     model = jittered_pond(lambda x, y: np.where(x < 15.0, 1.0, 0.7))
     p = model.particles
@@ -385,6 +446,6 @@ def test_a_small_particle_beside_a_large_one_still_finds_its_merge_partner():
     y = np.zeros(3)
     nstart = np.array([0, 2, 4, 6])
     nbr = np.array([1, 2, 0, 2, 0, 1])
-    out = np.empty(3, dtype=np.int64)
-    refine.nearest_candidate(x, y, nstart, nbr, np.array([True, True, False]), out)
+    out = np.full(3, -1, dtype=np.int64)
+    refine.nearest_of(np.array([0, 1]), x, y, nstart, nbr, np.array([True, True, False]), out)
     assert out.tolist() == [1, 0, -1]

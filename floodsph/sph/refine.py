@@ -112,22 +112,20 @@ def daughters_clear(xp, yp, x, y, wstart, wseg, seg, out):
 
 
 @njit(parallel=True, cache=True)
-def nearest_candidate(x, y, nstart, nbr, cand, out):
-    """Index of each candidate's nearest fellow candidate in the CSR list, else -1.
+def nearest_of(rows, x, y, nstart, nbr, partner, out):
+    """out[i] = the nearest j with ``partner[j]`` in the CSR list of each i in ``rows``, else
+    -1 (ties to the lower index, so the result is deterministic).
 
-    Pairing mutual nearest candidates (not nearest particles of any kind) lets a small
-    particle beside a large one still find a partner, and stays conflict-free. Ties are
-    broken by the lower index, so the result is deterministic.
+    Pairing mutual nearest candidates (``partner`` the candidates, not particles of any kind)
+    lets a small particle beside a large one still find a partner, and stays conflict-free.
     """
-    for i in prange(x.shape[0]):
+    for k in prange(rows.shape[0]):
+        i = rows[k]
         best = -1
         best_r2 = np.inf
-        if not cand[i]:
-            out[i] = best
-            continue
         for q in range(nstart[i], nstart[i + 1]):
             j = nbr[q]
-            if not cand[j] or j == i:
+            if not partner[j] or j == i:
                 continue
             dx = x[j] - x[i]
             dy = y[j] - y[i]
