@@ -300,18 +300,15 @@ class Refiner:
         b = nn[a]
         mutual = nn[b] == a
         a, b = idx[a[mutual]], idx[b[mutual]]
-        r = np.hypot(p.x[a] - p.x[b], p.y[a] - p.y[b])
-        ok = self._smooth_pairs(p, a, b) & (r < np.minimum(p.h[a], p.h[b]))
-        return a[ok], b[ok]
-
-    def _smooth_pairs(self, p, a, b) -> np.ndarray:
-        """True for the pairs (a, b) with no depth or velocity jump between them."""
         s = self.settings
         d_a, d_b = p.rho[a] / RHO_WATER, p.rho[b] / RHO_WATER
         d_max = np.maximum(d_a, d_b)
         dv = np.hypot(p.u[a] - p.u[b], p.v[a] - p.v[b])
-        return ((np.abs(d_a - d_b) <= s.depth_jump * d_max)
-                & (dv <= s.speed_jump * np.sqrt(GRAVITY * d_max)))
+        r = np.hypot(p.x[a] - p.x[b], p.y[a] - p.y[b])
+        ok = (np.abs(d_a - d_b) <= s.depth_jump * d_max)
+        ok &= dv <= s.speed_jump * np.sqrt(GRAVITY * d_max)
+        ok &= r < np.minimum(p.h[a], p.h[b])
+        return a[ok], b[ok]
 
     def _absorptions(self, model, cand, paired) -> tuple[np.ndarray, np.ndarray]:
         """Pairs (t, b) in which a small particle t is absorbed by a larger neighbour b.
@@ -321,12 +318,11 @@ class Refiner:
         of the small particles with the same b only the closest is absorbed, so no particle is
         in two merges. b must be settled (born at least ``no_merge_steps`` ago), away from
         walls and open boundaries (``FloodModel.protected``, over the merged particle's lattice
-        support), with no depth or velocity jump to t, closer than h_b, and A_t + A_b <
-        2 area_min (the merged particle does not split at once). The jump test is on velocity
-        alone, |v_t - v_b| <= speed_jump sqrt(g d_b) (across a bore or a front the speeds
-        differ too): with h below half of its neighbours', t's own summed depth is mostly its
-        self term and its nearest neighbour's, 2.9 m in 1 m of water 0.24 m from a neighbour
-        (``tests/test_refine.py``).
+        support), closer than h_b, with A_t + A_b < 2 area_min (the merged particle does not
+        split at once) and |v_t - v_b| <= speed_jump sqrt(g d_b). There is no depth test
+        (across a bore or a front the speeds differ too): with h below half of its
+        neighbours', t's own summed depth is mostly its self term and its nearest neighbour's,
+        2.9 m in 1 m of water 0.24 m from a neighbour (``tests/test_refine.py``).
         """
         from floodsph.sph import refine
         from floodsph.sph.neighbours import NeighbourList
@@ -339,8 +335,6 @@ class Refiner:
             return empty, empty
         n = p.n
         near = NeighbourList(p.x[:n], p.y[:n], 0.5 * p.h[:n], skin=0.0, rows=small)
-        is_small = np.zeros(n, dtype=np.bool_)
-        is_small[small] = True
         partner = np.ones(n, dtype=np.bool_)
         partner[paired] = False
         partner[small] = False
@@ -349,7 +343,7 @@ class Refiner:
         refine.nearest_of(small, p.x, p.y, near.start, near.nbr, partner, nn)
         t = small[nn[small] >= 0]
         b = nn[t]
-        # b's nearest small particle must be t: keep, for each b, the closest t
+        # of the small particles that chose the same b, keep the closest
         r = np.hypot(p.x[t] - p.x[b], p.y[t] - p.y[b])
         first = np.lexsort((t, r, b))
         keep = np.ones(first.size, dtype=bool)
