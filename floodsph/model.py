@@ -8,7 +8,8 @@ method notes 2.6-2.7):
 2. drift  x^{n+1} = x^n + v^{n+1/2} dt; moves across walls are reflected; particles that
           leave an open border or enter nodata are removed and counted as outflow
 3. density guess from continuity, neighbour lists, Newton-Raphson solve of rho and h
-4. forces a^{n+1} at (x^{n+1}, v^{n+1/2}): pressure + shock capturing + bed
+4. forces a^{n+1} at (x^{n+1}, v^{n+1/2}): pressure + shock capturing, balanced at shores
+          (``floodsph.sph.shore``), + bed
 5. kick   v^{n+1} = v^{n+1/2} + a^{n+1} dt / 2, then implicit Manning friction over dt
 6. next dt = cfl min h / (|v| + c)
 
@@ -32,7 +33,7 @@ from floodsph.boundaries.openings import cut_openings
 from floodsph.constants import RHO_WATER
 from floodsph.particles import ParticleSet
 from floodsph.sph import bed as bedmod
-from floodsph.sph import density, forces, local_steps
+from floodsph.sph import density, forces, local_steps, shore
 from floodsph.sph import walls as wallmod
 from floodsph.sph.neighbours import CellGrid, NeighbourList
 from floodsph.terrain import Terrain
@@ -150,6 +151,8 @@ class FloodModel:
                          "wall_reflections": 0, "density_unconverged": 0,
                          "density_capped": 0, "density_held": 0, "particle_updates": 0}
         self.bed = np.empty((0, 7))
+        self.pair_coef = np.empty((0, 4))
+        self.pair_sums = np.empty((0, forces.SUMS))
         self.blocked = np.empty(0, dtype=np.bool_)
         self.wdist = np.empty(0)
         self._blocked_nl = None
@@ -421,13 +424,22 @@ class FloodModel:
         t = self.terrain
         if self.bed.shape[0] != p.n:
             self.bed = np.empty((p.n, 7))
+            self.pair_coef = np.empty((p.n, 4))
+            self.pair_sums = np.empty((p.n, forces.SUMS))
         rows = self.nl.rows
         bedmod.sample_bed(rows, p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
             self._blocked_pairs()
-        forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
-                                     self.nl.start, self.nl.nbr, self.blocked, self.wdist,
-                                     *self.walls_near, self.seg, self.scheme, p.ax, p.ay, p.divv)
+        lists = (self.nl.start, self.nl.nbr, self.blocked, self.wdist, *self.walls_near,
+                 self.seg, self.scheme, self.pair_coef, self.pair_sums)
+        forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, *lists,
+                                     p.ax, p.ay, p.divv)
+        shore.cut_depths(rows, p.x, p.y, p.u, p.v, p.rho, p.h, self.bed, t.dx, t.dy, t.elevation,
+                         self.pair_sums)
+        at_shore = rows[self.pair_sums[rows, 7] > 0.0]
+        if at_shore.size:
+            forces.shore_sums(at_shore, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, *lists)
+            shore.balance_shores(at_shore, p.rho, self.pair_sums, p.ax, p.ay)
         forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
                                     p.ay)
 

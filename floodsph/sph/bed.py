@@ -36,6 +36,13 @@ def _lerp(g, i0, j0, tx, ty):
     )
 
 
+@njit(inline="always", cache=True)
+def elevation_at(x, y, dx, dy, grid, nx, ny):
+    """Bilinear sample of the (ny, nx) node-centred ``grid`` at one point (x, y) [m]."""
+    i0, j0, tx, ty = _weights(x, y, dx, dy, nx, ny)
+    return _lerp(grid, i0, j0, tx, ty)
+
+
 @njit(parallel=True, cache=True)
 def sample_bed(rows, x, y, dx, dy, bed, bx, by, bxx, bxy, byy, manning, out):
     """Sample the seven bed grids at the particles ``rows`` into their rows of ``out`` (n, 7).

@@ -16,6 +16,8 @@ term of both particles is replaced by the two-shock Riemann pressure p* = g rho_
 (Toro) of the pair, solved along the pair axis.
 
 Both forms are antisymmetric in (i, j): internal forces conserve linear momentum exactly.
+The same loop sums the hydrostatic pressure's parts that ``floodsph.sph.shore`` uses to
+balance it where the water ends on a rising bed (no change on a flat bed).
 Wall images (``floodsph.sph.walls``) enter the same pair terms; a particle's own images
 (across a wall, normal to it, and through a corner) with the kernel gradient held at its peak
 below q = r/h = 2/3 (:func:`floodsph.sph.kernels.dwdr_over_r_floored`). With the plain cubic
@@ -75,8 +77,8 @@ def riemann_pressure(d_l, d_r, u_l, u_r):
 
 
 @njit(parallel=True, cache=True)
-def pair_coefficients(rho, alpha, h, coef):
-    """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i).
+def pair_coefficients(m, rho, alpha, h, coef):
+    """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i, g A_i / 2).
 
     beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
     1 / h_i [m^-1]. A particle with no neighbour within its support (alpha_i = 0, possible
@@ -87,6 +89,7 @@ def pair_coefficients(rho, alpha, h, coef):
         coef[i, 0] = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
         coef[i, 1] = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
         coef[i, 2] = 1.0 / h[i]
+        coef[i, 3] = 0.5 * GRAVITY * m[i] / rho[i]
 
 
 @njit(inline="always", cache=True)
@@ -94,14 +97,17 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, image=False):
     """Pair terms of a_i^int and of div v_i for separation r = x_i - x_j, v = v_i - v_j.
 
     j's properties (mass, density, h, ``coef`` of :func:`pair_coefficients`) are taken at
-    index j, also for j's mirror images (whose r and v the caller passes). Returns
-    (fx, fy, fd): the caller subtracts them from a_i^int (x, y) and from the divergence sum
-    sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i). ``image``: j is i's own wall image (the
-    floored kernel gradient).
+    index j, also for j's mirror images (whose r and v the caller passes). Returns the terms
+    of a_i^int and of the divergence sum
+    sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i), as (rx, ry, f, w, fd): a_i^int takes - f r,
+    the divergence sum - fd, and w = (g / 2) (m_j / rho_j) (beta_i F_i + beta_j F_j) [s-2 m-2]
+    (F = (1/r) dW/dr) is the pair's hydrostatic weight, summed by :func:`_subtract` into the
+    shore terms of ``floodsph.sph.shore``. ``image``: j is i's own wall image (the floored
+    kernel gradient).
     """
     r2 = rx * rx + ry * ry
     if r2 <= 0.0:
-        return 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0
     r = math.sqrt(r2)
     inv_r = 1.0 / r
     if image:
@@ -126,12 +132,13 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, image=False):
         ci = k * coef[i, 0] + 0.5 * pi_ij
         cj = k * coef[j, 0] + 0.5 * pi_ij
     f = m[j] * (ci * fi + cj * fj)
-    return f * rx, f * ry, m[j] * fi * vr
+    w = coef[j, 3] * (coef[i, 0] * fi + coef[j, 0] * fj)
+    return rx, ry, f, w, m[j] * fi * vr
 
 
 @njit(parallel=True, cache=True)
 def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wdist, wstart,
-                          wseg, cstart, cpair, seg, scheme, ax, ay, divv):
+                          wseg, cstart, cpair, seg, scheme, coef, sums, ax, ay, divv):
     """a^int and div v of the particles ``rows`` (gather form), mirror images included.
 
     Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
@@ -141,51 +148,103 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, nstart, nbr, block
     (wstart, wseg, cstart, cpair) are those of
     :meth:`floodsph.sph.walls.WallIndex.near_lists`; images are summed segment by segment,
     each followed by the corners it opens, as in the density summation.
+
+    ``coef`` (n, 4) receives :func:`pair_coefficients` (for :func:`shore_sums`), and the
+    columns E (2-3) of ``sums`` (n, SUMS) the push per metre of depth of :func:`_subtract`.
     """
-    coef = np.empty((x.shape[0], 3))
-    pair_coefficients(rho, alpha, h, coef)
+    pair_coefficients(m, rho, alpha, h, coef)
     for k in prange(rows.shape[0]):
         i = rows[k]
-        xi = x[i]
-        yi = y[i]
-        hi = h[i]
-        fx = 0.0
-        fy = 0.0
-        fd = 0.0
-        h_reach = hi  # the largest h of i and its neighbours: no image beyond 2 h_reach
-        for q in range(nstart[i], nstart[i + 1]):
-            j = nbr[q]
-            rx = xi - x[j]
-            ry = yi - y[j]
-            h_reach = max(h_reach, h[j])
-            hm = 2.0 * max(hi, h[j])
-            if rx * rx + ry * ry >= hm * hm or blocked[q]:
-                continue
-            gx, gy, gd = pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m, rho, h, coef,
-                                    scheme)
-            fx -= gx
-            fy -= gy
-            fd -= gd
-        c = cstart[i]
-        for w in range(wstart[i], wstart[i + 1]):
-            s = wseg[w]
-            if wdist[w] < 2.0 * h_reach + SIGHT_SLACK:
-                fx, fy, fd = _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v,
-                                              m, rho, h, coef, seg, s, -1, wdist[w], scheme)
-            while c < cstart[i + 1] and cpair[c, 0] == s:
-                fx, fy, fd = _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v,
-                                              m, rho, h, coef, seg, s, cpair[c, 1], 0.0, scheme)
-                c += 1
-        ax[i] = fx
-        ay[i] = fy
-        divv[i] = coef[i, 0] * fd / rho[i]  # (2 / alpha_i) fd, with beta's fallback
+        acc = _particle_sums(i, x, y, u, v, m, rho, h, coef, nstart, nbr, blocked, wdist, wstart,
+                             wseg, cstart, cpair, seg, scheme, False)
+        ax[i] = acc[0]
+        ay[i] = acc[1]
+        sums[i, 2] = acc[4]
+        sums[i, 3] = acc[5]
+        divv[i] = coef[i, 0] * acc[9] / rho[i]  # (2 / alpha_i) fd, with beta's fallback
+
+
+@njit(parallel=True, cache=True)
+def shore_sums(rows, x, y, u, v, m, rho, h, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
+               cpair, seg, scheme, coef, sums):
+    """The difference part D (columns 0-1 of ``sums``) and g M (4-6) of :func:`_subtract` for
+    the particles ``rows`` (shore particles, few), with the ``coef`` that
+    :func:`internal_acceleration` left; same arguments as it."""
+    for k in prange(rows.shape[0]):
+        i = rows[k]
+        acc = _particle_sums(i, x, y, u, v, m, rho, h, coef, nstart, nbr, blocked, wdist, wstart,
+                             wseg, cstart, cpair, seg, scheme, True)
+        sums[i, 0] = acc[2]
+        sums[i, 1] = acc[3]
+        sums[i, 4] = acc[6]
+        sums[i, 5] = acc[7]
+        sums[i, 6] = acc[8]
 
 
 @njit(inline="always", cache=True)
-def _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, seg, s, s2,
-                     ds, scheme):
-    """Subtract from (fx, fy, fd) the pair terms on particle i of the images of i and of its
-    unblocked neighbours about segment s (s2 < 0) or about the corner of s and s2.
+def _particle_sums(i, x, y, u, v, m, rho, h, coef, nstart, nbr, blocked, wdist, wstart, wseg,
+                   cstart, cpair, seg, scheme, full):
+    """Particle i's pair sums (:func:`_subtract`) over its neighbours and mirror images."""
+    xi = x[i]
+    yi = y[i]
+    hi = h[i]
+    acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    h_reach = hi  # the largest h of i and its neighbours: no image beyond 2 h_reach
+    for q in range(nstart[i], nstart[i + 1]):
+        j = nbr[q]
+        rx = xi - x[j]
+        ry = yi - y[j]
+        h_reach = max(h_reach, h[j])
+        hm = 2.0 * max(hi, h[j])
+        if rx * rx + ry * ry >= hm * hm or blocked[q]:
+            continue
+        acc = _subtract(acc, i, j, rho, pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m,
+                                                   rho, h, coef, scheme), full)
+    c = cstart[i]
+    for w in range(wstart[i], wstart[i + 1]):
+        s = wseg[w]
+        if wdist[w] < 2.0 * h_reach + SIGHT_SLACK:
+            acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
+                                   seg, s, -1, wdist[w], scheme, full)
+        while c < cstart[i + 1] and cpair[c, 0] == s:
+            acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
+                                   seg, s, cpair[c, 1], 0.0, scheme, full)
+            c += 1
+    return acc
+
+
+SUMS = 8  # columns of the shore sums: D (x, y), E (x, y), g M (xx, xy, yy), the cut depth
+
+
+@njit(inline="always", cache=True)
+def _subtract(acc, i, j, rho, t, full):
+    """Subtract the terms t = (rx, ry, f, w, fd) of :func:`pair_force` for the pair of i and
+    j (or j's image) from i's sums ``acc``, a tuple, with d = rho / rho_w:
+
+    0-1: a^int = - sum f r [m s-2];
+    2-3: D = - sum w (d_j - d_i) r [m s-2], the hydrostatic pressure force's difference part;
+    4-5: E = - sum w r [s-2], its push per metre of i's own depth (a^p = D + d_i E);
+    6-8: g M = - sum w r r^T, as xx, xy, yy [s-2] (M = I in a full support);
+    9: the divergence sum, - sum fd.
+
+    D and M (needed at shores only) are summed when ``full``.
+    """
+    rx, ry, f, w, fd = t
+    if full:
+        wd = w * (rho[j] - rho[i]) * (1.0 / RHO_WATER)
+        return (acc[0] - f * rx, acc[1] - f * ry, acc[2] - wd * rx, acc[3] - wd * ry,
+                acc[4] - w * rx, acc[5] - w * ry, acc[6] - w * rx * rx, acc[7] - w * rx * ry,
+                acc[8] - w * ry * ry, acc[9] - fd)
+    return (acc[0] - f * rx, acc[1] - f * ry, acc[2], acc[3], acc[4] - w * rx, acc[5] - w * ry,
+            acc[6], acc[7], acc[8], acc[9] - fd)
+
+
+@njit(inline="always", cache=True)
+def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, seg, s, s2, ds,
+                     scheme, full):
+    """Subtract from ``acc`` (:func:`_subtract`) the pair terms on particle i of the images of
+    i and of its unblocked neighbours about segment s (s2 < 0) or about the corner of s and
+    s2.
 
     ``ds`` is the distance [m] from i to segment s (0 for a corner): the image of j about s
     is at least ds - SIGHT_SLACK from i, so for ds >= 2 max(h_i, h_j) + SIGHT_SLACK its pair
@@ -194,31 +253,26 @@ def _subtract_images(fx, fy, fd, i, nstart, nbr, blocked, x, y, u, v, m, rho, h,
     hi = h[i]
     if ds < 2.0 * hi + SIGHT_SLACK:
         if s2 < 0:
-            gx, gy, gd = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
+            t = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
         else:
-            gx, gy, gd = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-        fx -= gx
-        fy -= gy
-        fd -= gd
+            t = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
+        acc = _subtract(acc, i, i, rho, t, full)
     for q in range(nstart[i], nstart[i + 1]):
         if blocked[q] or ds >= 2.0 * max(hi, h[nbr[q]]) + SIGHT_SLACK:
             continue
         if s2 < 0:
-            gx, gy, gd = _image_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, scheme)
+            t = _image_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, scheme)
         else:
-            gx, gy, gd = _corner_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, s2,
-                                       scheme)
-        fx -= gx
-        fy -= gy
-        fd -= gd
-    return fx, fy, fd
+            t = _corner_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
+        acc = _subtract(acc, i, nbr[q], rho, t, full)
+    return acc
 
 
 @njit(inline="always", cache=True)
 def _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme):
     xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
     if not ok:
-        return 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0
     _, _, _, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
     vn = u[j] * nx + v[j] * ny
     um = u[j] - 2.0 * vn * nx
@@ -231,7 +285,7 @@ def _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme):
 def _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s1, s2, scheme):
     xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
     if not ok:
-        return 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0
     # two reflections of the velocity: about s1's normal, then s2's
     _, _, _, n1x, n1y = mirror(x[j], y[j], seg[s1, 0], seg[s1, 1], seg[s1, 2], seg[s1, 3])
     _, _, _, n2x, n2y = mirror(x[j], y[j], seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])

@@ -1,0 +1,68 @@
+"""Shores of still water on a rising bed (``floodsph.sph.shore``)."""
+
+import numpy as np
+from sph_cases import model_on, run_until
+
+from floodsph.sph import forces
+
+SLOPE = 0.03
+
+
+def variational_acceleration(model):
+    """The accelerations without the shore balance: the pair forces and the bed term alone."""
+    p = model.particles
+    ax, ay, divv = np.empty(p.n), np.empty(p.n), np.empty(p.n)
+    forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
+                                 model.nl.start, model.nl.nbr, model.blocked, model.wdist,
+                                 *model.walls_near, model.seg, model.scheme,
+                                 np.empty((p.n, 4)), np.empty((p.n, forces.SUMS)), ax, ay, divv)
+    forces.add_bed_acceleration(model.nl.rows, p.u, p.v, model.bed, model.numerics.max_slope,
+                                ax, ay)
+    return ax, ay
+
+
+def test_the_shore_of_a_lake_on_a_slope_is_held_up_the_slope():
+    """A lake 6 m deep at x = 0 on a 3 % slope, shore at x = 200 m, 10 m particles. The
+    variational force pulls the shore row down the slope at 32 % of g s (its edge push and the
+    cut difference part fall short of the bed's pull); with the push cut and the difference
+    part renormalised, 10 % (measured 0.095 and 0.028 m s-2). Away from the shore and from the
+    wall at the deep end the lake is balanced."""
+    model = model_on(lambda x, y: SLOPE * x, (0, 400), (0, 200), 10.0, 6.0, 10.0)
+    p = model.particles
+    pull = 9.81 * SLOPE
+    shore = p.x > p.x.max() - 1.0
+    ax, _ = variational_acceleration(model)
+    assert shore.sum() == 20
+    assert np.all(-ax[shore] > 0.25 * pull)
+    assert np.all(np.abs(p.ax[shore]) < 0.15 * pull)
+    inner = (p.x > 2.0 * p.h.max()) & (p.x < p.x.max() - 2.0 * p.h.max())
+    assert np.abs(p.ax[inner]).max() < 0.01 * pull
+
+
+def test_on_a_flat_bed_the_shore_balance_changes_nothing():
+    """A dam break on a flat bed: the force at its front is the variational one, bit for bit
+    (the push is kept, so momentum is conserved)."""
+    model = model_on(lambda x, y: 0 * x, (0, 300), (0, 100), 10.0,
+                     lambda x, y: np.where(x < 150, 4.0, 0.0), 10.0)
+    run_until(model, 10.0)
+    model._forces()
+    ax, ay = variational_acceleration(model)
+    np.testing.assert_array_equal(model.particles.ax, ax)
+    np.testing.assert_array_equal(model.particles.ay, ay)
+
+
+def test_the_shore_of_a_lake_in_a_bowl_stays_in_place():
+    """Still water 5 m deep in a paraboloid (shore at r = 354 m, 2.8 % slope there), 10 m
+    particles, frictionless, 200 s: the level stays within 1 % of the depth and the shore
+    within a spacing of where it was; the fastest particle, at the shore, moves at 4.6 cm/s
+    (0.97 m/s without the shore balance; the 1 cm/s target is the strict xfail of
+    ``test_sph_dynamics.py``)."""
+    bowl = lambda x, y: 10.0 * ((x - 500) ** 2 + (y - 500) ** 2) / 500.0**2  # noqa: E731
+    model = model_on(bowl, (0, 1000), (0, 1000), 10.0, 5.0, 10.0)
+    p = model.particles
+    r0 = np.hypot(p.x - 500, p.y - 500).max()
+    run_until(model, 200.0)
+    level = model.depth() + model.bed[:, 0]
+    assert np.abs(level - 5.0).max() < 0.01 * 5.0
+    assert abs(np.hypot(p.x - 500, p.y - 500).max() - r0) < 10.0
+    assert np.hypot(p.u, p.v).max() < 0.1
