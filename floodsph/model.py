@@ -151,8 +151,8 @@ class FloodModel:
                          "wall_reflections": 0, "density_unconverged": 0,
                          "density_capped": 0, "density_held": 0, "particle_updates": 0}
         self.bed = np.empty((0, 7))
-        self.pair_coef = np.empty((0, 4))
         self.pair_sums = np.empty((0, forces.SUMS))
+        self.shores = bool(np.ptp(terrain.elevation) > 0.0)  # a flat bed has no shore to balance
         self.blocked = np.empty(0, dtype=np.bool_)
         self.wdist = np.empty(0)
         self._blocked_nl = None
@@ -424,22 +424,18 @@ class FloodModel:
         t = self.terrain
         if self.bed.shape[0] != p.n:
             self.bed = np.empty((p.n, 7))
-            self.pair_coef = np.empty((p.n, 4))
             self.pair_sums = np.empty((p.n, forces.SUMS))
         rows = self.nl.rows
         bedmod.sample_bed(rows, p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
             self._blocked_pairs()
-        lists = (self.nl.start, self.nl.nbr, self.blocked, self.wdist, *self.walls_near,
-                 self.seg, self.scheme, self.pair_coef, self.pair_sums)
-        forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, *lists,
-                                     p.ax, p.ay, p.divv)
-        shore.cut_depths(rows, p.x, p.y, p.u, p.v, p.rho, p.h, self.bed, t.dx, t.dy, t.elevation,
-                         self.pair_sums)
-        at_shore = rows[self.pair_sums[rows, 7] > 0.0]
-        if at_shore.size:
-            forces.shore_sums(at_shore, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, *lists)
-            shore.balance_shores(at_shore, p.rho, self.pair_sums, p.ax, p.ay)
+        forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
+                                     self.nl.start, self.nl.nbr, self.blocked, self.wdist,
+                                     *self.walls_near, self.seg, self.scheme, self.shores,
+                                     self.pair_sums, p.ax, p.ay, p.divv)
+        if self.shores:
+            shore.balance_shores(rows, p.x, p.y, p.u, p.v, p.rho, p.h, self.bed, t.dx, t.dy,
+                                 t.elevation, self.pair_sums, p.ax, p.ay)
         forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
                                     p.ay)
 

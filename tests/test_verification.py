@@ -27,8 +27,8 @@ def test_stoker_dam_break_coarse():
 def test_thacker_basin_one_period_coarse():
     r = cases.thacker(200.0)
     assert r.mass_error_rel < 1e-12
-    assert r.l1 < 0.03  # measured 2.6 % at 200 m (2.9 % without the shore balance)
-    assert abs(r.front_error_m) <= 0.25 * 200.0  # measured 39 m behind (98 m without it)
+    assert r.l1 < 0.03  # measured 2.7 % at 200 m (2.9 % without the shore balance)
+    assert abs(r.front_error_m) <= 0.25 * 200.0  # measured 43 m behind (98 m without it)
 
 
 @pytest.mark.slow

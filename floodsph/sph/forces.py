@@ -138,7 +138,7 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, image=False):
 
 @njit(parallel=True, cache=True)
 def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wdist, wstart,
-                          wseg, cstart, cpair, seg, scheme, coef, sums, ax, ay, divv):
+                          wseg, cstart, cpair, seg, scheme, shores, sums, ax, ay, divv):
     """a^int and div v of the particles ``rows`` (gather form), mirror images included.
 
     Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
@@ -149,75 +149,52 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, nstart, nbr, block
     :meth:`floodsph.sph.walls.WallIndex.near_lists`; images are summed segment by segment,
     each followed by the corners it opens, as in the density summation.
 
-    ``coef`` (n, 4) receives :func:`pair_coefficients` (for :func:`shore_sums`), and the
-    columns E (2-3) of ``sums`` (n, SUMS) the push per metre of depth of :func:`_subtract`.
+    With ``shores`` (a bed that is not flat), row i of ``sums`` (n, SUMS) receives particle
+    i's shore sums (columns 2-8 of :func:`_subtract`), for ``floodsph.sph.shore``; on a flat
+    bed they are not needed and not summed (20 % of the loop's time).
     """
+    coef = np.empty((x.shape[0], 4))
     pair_coefficients(m, rho, alpha, h, coef)
     for k in prange(rows.shape[0]):
         i = rows[k]
-        acc = _particle_sums(i, x, y, u, v, m, rho, h, coef, nstart, nbr, blocked, wdist, wstart,
-                             wseg, cstart, cpair, seg, scheme, False)
+        xi = x[i]
+        yi = y[i]
+        hi = h[i]
+        acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        h_reach = hi  # the largest h of i and its neighbours: no image beyond 2 h_reach
+        for q in range(nstart[i], nstart[i + 1]):
+            j = nbr[q]
+            rx = xi - x[j]
+            ry = yi - y[j]
+            h_reach = max(h_reach, h[j])
+            hm = 2.0 * max(hi, h[j])
+            if rx * rx + ry * ry >= hm * hm or blocked[q]:
+                continue
+            acc = _subtract(acc, i, j, rho, pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m,
+                                                       rho, h, coef, scheme), shores)
+        c = cstart[i]
+        for w in range(wstart[i], wstart[i + 1]):
+            s = wseg[w]
+            if wdist[w] < 2.0 * h_reach + SIGHT_SLACK:
+                acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
+                                       seg, s, -1, wdist[w], scheme, shores)
+            while c < cstart[i + 1] and cpair[c, 0] == s:
+                acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
+                                       seg, s, cpair[c, 1], 0.0, scheme, shores)
+                c += 1
         ax[i] = acc[0]
         ay[i] = acc[1]
-        sums[i, 2] = acc[4]
-        sums[i, 3] = acc[5]
+        if shores:
+            for c in range(SUMS):
+                sums[i, c] = acc[2 + c]
         divv[i] = coef[i, 0] * acc[9] / rho[i]  # (2 / alpha_i) fd, with beta's fallback
 
 
-@njit(parallel=True, cache=True)
-def shore_sums(rows, x, y, u, v, m, rho, h, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
-               cpair, seg, scheme, coef, sums):
-    """The difference part D (columns 0-1 of ``sums``) and g M (4-6) of :func:`_subtract` for
-    the particles ``rows`` (shore particles, few), with the ``coef`` that
-    :func:`internal_acceleration` left; same arguments as it."""
-    for k in prange(rows.shape[0]):
-        i = rows[k]
-        acc = _particle_sums(i, x, y, u, v, m, rho, h, coef, nstart, nbr, blocked, wdist, wstart,
-                             wseg, cstart, cpair, seg, scheme, True)
-        sums[i, 0] = acc[2]
-        sums[i, 1] = acc[3]
-        sums[i, 4] = acc[6]
-        sums[i, 5] = acc[7]
-        sums[i, 6] = acc[8]
+SUMS = 7  # columns of the shore sums: D (x, y), E (x, y), g M (xx, xy, yy)
 
 
 @njit(inline="always", cache=True)
-def _particle_sums(i, x, y, u, v, m, rho, h, coef, nstart, nbr, blocked, wdist, wstart, wseg,
-                   cstart, cpair, seg, scheme, full):
-    """Particle i's pair sums (:func:`_subtract`) over its neighbours and mirror images."""
-    xi = x[i]
-    yi = y[i]
-    hi = h[i]
-    acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    h_reach = hi  # the largest h of i and its neighbours: no image beyond 2 h_reach
-    for q in range(nstart[i], nstart[i + 1]):
-        j = nbr[q]
-        rx = xi - x[j]
-        ry = yi - y[j]
-        h_reach = max(h_reach, h[j])
-        hm = 2.0 * max(hi, h[j])
-        if rx * rx + ry * ry >= hm * hm or blocked[q]:
-            continue
-        acc = _subtract(acc, i, j, rho, pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m,
-                                                   rho, h, coef, scheme), full)
-    c = cstart[i]
-    for w in range(wstart[i], wstart[i + 1]):
-        s = wseg[w]
-        if wdist[w] < 2.0 * h_reach + SIGHT_SLACK:
-            acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
-                                   seg, s, -1, wdist[w], scheme, full)
-        while c < cstart[i + 1] and cpair[c, 0] == s:
-            acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
-                                   seg, s, cpair[c, 1], 0.0, scheme, full)
-            c += 1
-    return acc
-
-
-SUMS = 8  # columns of the shore sums: D (x, y), E (x, y), g M (xx, xy, yy), the cut depth
-
-
-@njit(inline="always", cache=True)
-def _subtract(acc, i, j, rho, t, full):
+def _subtract(acc, i, j, rho, t, shores):
     """Subtract the terms t = (rx, ry, f, w, fd) of :func:`pair_force` for the pair of i and
     j (or j's image) from i's sums ``acc``, a tuple, with d = rho / rho_w:
 
@@ -227,21 +204,21 @@ def _subtract(acc, i, j, rho, t, full):
     6-8: g M = - sum w r r^T, as xx, xy, yy [s-2] (M = I in a full support);
     9: the divergence sum, - sum fd.
 
-    D and M (needed at shores only) are summed when ``full``.
+    Terms 2-8 only with ``shores``.
     """
     rx, ry, f, w, fd = t
-    if full:
-        wd = w * (rho[j] - rho[i]) * (1.0 / RHO_WATER)
-        return (acc[0] - f * rx, acc[1] - f * ry, acc[2] - wd * rx, acc[3] - wd * ry,
-                acc[4] - w * rx, acc[5] - w * ry, acc[6] - w * rx * rx, acc[7] - w * rx * ry,
-                acc[8] - w * ry * ry, acc[9] - fd)
-    return (acc[0] - f * rx, acc[1] - f * ry, acc[2], acc[3], acc[4] - w * rx, acc[5] - w * ry,
-            acc[6], acc[7], acc[8], acc[9] - fd)
+    if not shores:
+        return (acc[0] - f * rx, acc[1] - f * ry, acc[2], acc[3], acc[4], acc[5], acc[6],
+                acc[7], acc[8], acc[9] - fd)
+    wd = w * (rho[j] - rho[i]) * (1.0 / RHO_WATER)
+    return (acc[0] - f * rx, acc[1] - f * ry, acc[2] - wd * rx, acc[3] - wd * ry,
+            acc[4] - w * rx, acc[5] - w * ry, acc[6] - w * rx * rx, acc[7] - w * rx * ry,
+            acc[8] - w * ry * ry, acc[9] - fd)
 
 
 @njit(inline="always", cache=True)
 def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, seg, s, s2, ds,
-                     scheme, full):
+                     scheme, shores):
     """Subtract from ``acc`` (:func:`_subtract`) the pair terms on particle i of the images of
     i and of its unblocked neighbours about segment s (s2 < 0) or about the corner of s and
     s2.
@@ -256,7 +233,7 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
             t = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
         else:
             t = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-        acc = _subtract(acc, i, i, rho, t, full)
+        acc = _subtract(acc, i, i, rho, t, shores)
     for q in range(nstart[i], nstart[i + 1]):
         if blocked[q] or ds >= 2.0 * max(hi, h[nbr[q]]) + SIGHT_SLACK:
             continue
@@ -264,7 +241,7 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
             t = _image_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, scheme)
         else:
             t = _corner_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-        acc = _subtract(acc, i, nbr[q], rho, t, full)
+        acc = _subtract(acc, i, nbr[q], rho, t, shores)
     return acc
 
 
