@@ -60,12 +60,3 @@ def sample_bed(rows, x, y, dx, dy, bed, bx, by, bxx, bxy, byy, manning, out):
         out[p, 4] = _lerp(bxy, i0, j0, tx, ty)
         out[p, 5] = _lerp(byy, i0, j0, tx, ty)
         out[p, 6] = _lerp(manning, i0, j0, tx, ty)
-
-
-@njit(cache=True)
-def sample_grid(x, y, dx, dy, grid, out):
-    """Bilinear sample of one node-centred grid at points (x, y) into ``out``."""
-    ny, nx = grid.shape
-    for p in range(x.shape[0]):
-        i0, j0, tx, ty = _weights(x[p], y[p], dx, dy, nx, ny)
-        out[p] = _lerp(grid, i0, j0, tx, ty)
