@@ -81,9 +81,9 @@ def pair_coefficients(m, rho, alpha, h, coef):
     """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i, g A_i / 2).
 
     beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
-    1 / h_i [m^-1]. A particle with no neighbour within its support (alpha_i = 0, possible
-    when its h is held back by its lists) takes beta_i = 1, the uncorrected force (alpha_i =
-    2 rho_i on a lattice).
+    1 / h_i [m^-1], g A_i / 2 [m3 s-2] with the area A_i = m_i / rho_i. A particle with no
+    neighbour within its support (alpha_i = 0, possible when its h is held back by its lists)
+    takes beta_i = 1, the uncorrected force (alpha_i = 2 rho_i on a lattice).
     """
     for i in prange(rho.shape[0]):
         coef[i, 0] = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
