@@ -39,16 +39,27 @@ def test_the_shore_of_a_lake_on_a_slope_is_held_up_the_slope():
     assert np.abs(p.ax[inner]).max() < 0.01 * pull
 
 
-def test_on_a_flat_bed_the_shore_balance_changes_nothing():
-    """A dam break on a flat bed: the force at its front is the variational one, bit for bit
-    (the push is kept, so momentum is conserved)."""
-    model = model_on(lambda x, y: 0 * x, (0, 300), (0, 100), 10.0,
-                     lambda x, y: np.where(x < 150, 4.0, 0.0), 10.0)
+def test_a_front_running_downhill_keeps_its_push():
+    """A dam break on a bed falling 1e-3 downstream, at 10 s: the bed beyond the front lies
+    lower, so the force at the front (the last two h) is the variational one, bit for bit;
+    behind it, where the push of a full support is noise, the balance moves no particle's
+    acceleration by more than 1e-3 m s-2 (measured 9e-5, 10 particles of 150). On a flat
+    DEM the balance is off."""
+    def dam_break(bed):
+        return model_on(bed, (0, 300), (0, 100), 10.0,
+                        lambda x, y: np.where(x < 150, 4.0, 0.0), 10.0)
+
+    assert not dam_break(lambda x, y: 0 * x).shores
+    model = dam_break(lambda x, y: -1e-3 * x)
     run_until(model, 10.0)
     model._forces()
+    p = model.particles
     ax, ay = variational_acceleration(model)
-    np.testing.assert_array_equal(model.particles.ax, ax)
-    np.testing.assert_array_equal(model.particles.ay, ay)
+    front = p.x > p.x.max() - 2.0 * p.h.max()
+    assert model.shores and front.sum() > 10
+    np.testing.assert_array_equal(p.ax[front], ax[front])
+    np.testing.assert_array_equal(p.ay[front], ay[front])
+    assert np.hypot(p.ax - ax, p.ay - ay).max() < 1e-3
 
 
 def test_the_shore_of_a_lake_in_a_bowl_stays_in_place():

@@ -97,13 +97,12 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, image=False):
     """Pair terms of a_i^int and of div v_i for separation r = x_i - x_j, v = v_i - v_j.
 
     j's properties (mass, density, h, ``coef`` of :func:`pair_coefficients`) are taken at
-    index j, also for j's mirror images (whose r and v the caller passes). Returns the terms
-    of a_i^int and of the divergence sum
-    sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i), as (rx, ry, f, w, fd): a_i^int takes - f r,
-    the divergence sum - fd, and w = (g / 2) (m_j / rho_j) (beta_i F_i + beta_j F_j) [s-2 m-2]
-    (F = (1/r) dW/dr) is the pair's hydrostatic weight, summed by :func:`_subtract` into the
-    shore terms of ``floodsph.sph.shore``. ``image``: j is i's own wall image (the floored
-    kernel gradient).
+    index j, also for j's mirror images (whose r and v the caller passes). Returns
+    (rx, ry, f, w, fd), summed by :func:`_subtract`: a_i^int takes - f r, the divergence sum
+    sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i) takes - fd, and
+    w = (g / 2) (m_j / rho_j) (beta_i F_i + beta_j F_j) [s-2 m-2] (F = (1/r) dW/dr) is the
+    pair's hydrostatic weight, for the shore terms of ``floodsph.sph.shore``. ``image``: j is
+    i's own wall image (the floored kernel gradient).
     """
     r2 = rx * rx + ry * ry
     if r2 <= 0.0:
