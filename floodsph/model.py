@@ -51,7 +51,10 @@ class Numerics:
     """Numerical settings of the solver (defaults are the recommended production values).
 
     cfl : Courant number of dt = cfl min h / (|v| + c).
-    kappa : h0 / particle spacing.
+    kappa : h0 / particle spacing. 1.2 (SWE-SPHysics' suggested value, method notes 1.4): on
+        the square lattice the water is seeded on, still water is then a minimum of the SPH
+        energy and stays still; at 1.3, 1.25, 1.15 or 1.4-2 the lattice is a saddle of it and
+        a still lake stirs itself up within minutes (``workflows/lattice_stability.py``).
     spacing : initial particle spacing [m].
     density_tol : Newton-Raphson tolerance on |R| / rho.
     density_max_iter : iteration cap of the density solve.
@@ -67,7 +70,7 @@ class Numerics:
     """
 
     cfl: float = 0.3
-    kappa: float = 1.3
+    kappa: float = 1.2
     spacing: float = 10.0
     density_tol: float = 1e-3
     density_max_iter: int = 20

@@ -171,7 +171,7 @@ class NumericsConfig:
     cfl: float = 0.3
     refinement: Refinement = Refinement.SPLIT_COALESCE
     threads: int = 0
-    kappa: float = 1.3
+    kappa: float = 1.2
     stabilisation: Stabilisation = Stabilisation.LAX_FRIEDRICHS
     density_tol: float = 1e-3
     friction_depth_floor_m: float = 0.01

@@ -114,7 +114,8 @@ def _channel_profile(model, xq):
     return _depth_at(model, X.ravel(), Y.ravel()).reshape(X.shape).mean(axis=0)
 
 
-def ritter(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseResult:
+def ritter(dx: float, kappa: float = Numerics.kappa, refinement=None,
+           **numerics) -> CaseResult:
     """Dry-bed dam break (Ritter), d0 = 10 m, t = 50 s; ``refinement`` a ``Refinement``
     (default: uniform resolution)."""
     d0, t_end = 10.0, 50.0
@@ -132,7 +133,8 @@ def ritter(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseRe
                       abs(model.volume() - v0) / v0, *_labels(refinement, model))
 
 
-def stoker(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseResult:
+def stoker(dx: float, kappa: float = Numerics.kappa, refinement=None,
+           **numerics) -> CaseResult:
     """Wet-bed dam break (Stoker), 10 m over 2 m, t = 50 s."""
     d_l, d_r, t_end = 10.0, 2.0, 50.0
     model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
@@ -152,7 +154,7 @@ def stoker(dx: float, kappa: float = 1.3, refinement=None, **numerics) -> CaseRe
                       abs(model.volume() - v0) / v0, *_labels(refinement, model))
 
 
-def thacker(dx: float, kappa: float = 1.3, periods: float = 1.0, refinement=None,
+def thacker(dx: float, kappa: float = Numerics.kappa, periods: float = 1.0, refinement=None,
             **numerics) -> CaseResult:
     """Thacker's planar surface in a paraboloid, frictionless, over ``periods`` periods."""
     h0, a, eta = 10.0, 3000.0, 1500.0

@@ -26,8 +26,8 @@ def particles_with_depth(x, y, d, dx, kappa, u=0.0, v=0.0) -> ParticleSet:
     return p
 
 
-def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=1.3, manning=0.0, walls=(),
-             closed=True, **numerics):
+def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, manning=0.0,
+             walls=(), closed=True, **numerics):
     """A FloodModel with water given as a level (float) or a depth function d(x, y)."""
     terrain = Terrain.from_function(bed, xlim, ylim, cell, manning=manning)
     x, y = lattice(0.0, terrain.width, 0.0, terrain.height, dx)

@@ -27,6 +27,7 @@ from floodsph.model import FloodModel, Numerics
 from floodsph.terrain import Terrain
 
 G = GRAVITY
+KAPPA = Numerics.kappa
 
 
 # -- the boundary state --------------------------------------------------------------------------
@@ -67,7 +68,7 @@ def test_lattice_alpha_ratio_matches_the_solver_on_a_lattice():
     """alpha / rho of the buffer equals the value the density solve gives inside a lattice."""
     terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 200), (0, 200), 5.0)
     x, y = lattice(0, 200, 0, 200, 10.0)
-    model = FloodModel(terrain, particles_with_depth(x, y, np.full(x.shape, 2.0), 10.0, 1.3),
+    model = FloodModel(terrain, particles_with_depth(x, y, np.full(x.shape, 2.0), 10.0, KAPPA),
                        Numerics(spacing=10.0))
     p = model.particles
     centre = np.argmin(np.hypot(p.x - 100, p.y - 100))
@@ -96,19 +97,19 @@ def test_inflow_refuses_bad_lines():
     terrain = _flat(100, 100)
     hg = Hydrograph([0.0, 10.0], [1.0, 1.0])
     with pytest.raises(InputError, match=r"inflows\[2\].line: .*zero-length"):
-        Inflow([[10, 10], [10, 10]], hg, 5.0, 1.3, terrain, name="inflows[2]")
+        Inflow([[10, 10], [10, 10]], hg, 5.0, KAPPA, terrain, name="inflows[2]")
     with pytest.raises(InputError, match=r"inflows\[0\]: the ground is level.*direction"):
-        Inflow([[50, 20], [50, 80]], hg, 5.0, 1.3, terrain)
+        Inflow([[50, 20], [50, 80]], hg, 5.0, KAPPA, terrain)
     with pytest.raises(InputError, match=r"inflows\[0\].direction: .*parallel"):
-        Inflow([[50, 20], [50, 80]], hg, 5.0, 1.3, terrain, direction=[0, 1])
+        Inflow([[50, 20], [50, 80]], hg, 5.0, KAPPA, terrain, direction=[0, 1])
 
 
 def test_inflow_enters_towards_lower_ground_or_off_the_dem_edge():
     slope = Terrain.from_function(lambda x, y: 0.01 * x, (0, 200), (0, 100), 5.0)
     hg = Hydrograph([0.0, 10.0], [1.0, 1.0])
-    inflow = Inflow([[100, 20], [100, 80]], hg, 5.0, 1.3, slope)
+    inflow = Inflow([[100, 20], [100, 80]], hg, 5.0, KAPPA, slope)
     assert inflow.normal == pytest.approx([-1.0, 0.0])  # towards lower ground (west)
-    edge = Inflow([[0, 40], [0, 60]], hg, 5.0, 1.3, _flat(200, 100))
+    edge = Inflow([[0, 40], [0, 60]], hg, 5.0, KAPPA, _flat(200, 100))
     assert edge.normal == pytest.approx([1.0, 0.0])  # into the DEM from its west edge
 
 
@@ -121,9 +122,9 @@ def test_floodplain_inflow_injects_the_hydrograph_volume():
     dx = 2.5
     terrain = _flat(200, 200, cell=5.0, manning=0.05)
     hg = Hydrograph([0.0, 30.0, 150.0, 180.0], [0.0, 20.0, 20.0, 0.0])
-    inflow = Inflow([[0, 90], [0, 110]], hg, dx, 1.3, terrain)
+    inflow = Inflow([[0, 90], [0, 110]], hg, dx, KAPPA, terrain)
     model = FloodModel(terrain, particles_with_depth(np.zeros(0), np.zeros(0), np.zeros(0), dx,
-                                                     1.3), Numerics(spacing=dx),
+                                                     KAPPA), Numerics(spacing=dx),
                        boundaries=[inflow])
     row = critical_depth(1.0) * 20.0 * dx  # volume of one buffer row at the peak [m3]
     fronts, lags = [], []
@@ -148,8 +149,8 @@ def test_injected_volume_matches_the_hydrograph_from_trickle_to_steep_rise(times
     dx = 2.5
     terrain = _flat(120, 100, cell=5.0, manning=0.03)
     hg = Hydrograph(times, discharges)
-    inflow = Inflow([[0, 40], [0, 60]], hg, dx, 1.3, terrain)
-    empty = particles_with_depth(np.zeros(0), np.zeros(0), np.zeros(0), dx, 1.3)
+    inflow = Inflow([[0, 40], [0, 60]], hg, dx, KAPPA, terrain)
+    empty = particles_with_depth(np.zeros(0), np.zeros(0), np.zeros(0), dx, KAPPA)
     model = FloodModel(terrain, empty, Numerics(spacing=dx), boundaries=[inflow])
     for t in np.linspace(5.0, times[-1], 8):
         run_until(model, t)
@@ -165,7 +166,7 @@ def test_injected_volume_matches_the_hydrograph_from_trickle_to_steep_rise(times
 def test_still_water_at_an_open_edge_does_not_drain():
     terrain = _flat(300, 100)
     x, y = lattice(0, 300, 0, 100, 10.0)
-    model = FloodModel(terrain, particles_with_depth(x, y, np.full(x.shape, 2.0), 10.0, 1.3),
+    model = FloodModel(terrain, particles_with_depth(x, y, np.full(x.shape, 2.0), 10.0, KAPPA),
                        Numerics(spacing=10.0), closed_edges=("south", "north", "west"))
     v0 = model.volume()
     run_until(model, 200.0)
@@ -184,8 +185,8 @@ def test_uniform_flow_in_a_sloping_channel_stays_normal():
     terrain = Terrain.from_function(lambda x, y: -s0 * x, (0, length), (0, width), 5.0,
                                     manning=n)
     x, y = lattice(0, length, 0, width, dx)
-    particles = particles_with_depth(x, y, np.full(x.shape, d0), dx, 1.3, u=q / d0)
-    inflow = Inflow([[0, 0], [0, width]], Hydrograph([0.0, 1e6], [q * width] * 2), dx, 1.3,
+    particles = particles_with_depth(x, y, np.full(x.shape, d0), dx, KAPPA, u=q / d0)
+    inflow = Inflow([[0, 0], [0, width]], Hydrograph([0.0, 1e6], [q * width] * 2), dx, KAPPA,
                     terrain)
     model = FloodModel(terrain, particles, Numerics(spacing=dx),
                        closed_edges=("south", "north", "west"), boundaries=[inflow])
@@ -206,7 +207,7 @@ def _dam_break(length, d_left, d_right, closed, dx=10.0):
     x, y = lattice(0, length, 0, 40.0, dx)
     depth = np.where(x < 1000.0, d_left, d_right)
     wet = depth > 0
-    return FloodModel(terrain, particles_with_depth(x[wet], y[wet], depth[wet], dx, 1.3),
+    return FloodModel(terrain, particles_with_depth(x[wet], y[wet], depth[wet], dx, KAPPA),
                       Numerics(spacing=dx), closed_edges=closed)
 
 
@@ -249,8 +250,8 @@ def test_sink_absorbs_and_counts_the_water_that_reaches_it():
     terrain = _flat(1000, 40, cell=10.0)
     x, y = lattice(0, 1000, 0, 40, dx)
     d = np.where(x < 300, 5.0, 0.0)
-    sink = Sink([[700, -10], [1100, -10], [1100, 50], [700, 50]], terrain, reach=4 * 1.3 * dx)
-    model = FloodModel(terrain, particles_with_depth(x[d > 0], y[d > 0], d[d > 0], dx, 1.3),
+    sink = Sink([[700, -10], [1100, -10], [1100, 50], [700, 50]], terrain, reach=4 * KAPPA * dx)
+    model = FloodModel(terrain, particles_with_depth(x[d > 0], y[d > 0], d[d > 0], dx, KAPPA),
                        Numerics(spacing=dx), boundaries=[sink])
     v0 = model.volume()
     run_until(model, 120.0)

@@ -41,7 +41,7 @@ def lattice_alpha_ratio(dx_l: float, dx_n: float, h: float) -> float:
 
     With alpha = -sum_j m_j r_ij dW/dr and, in 2-D, h dW/dh = -(2 W + r dW/dr), alpha equals
     2 rho + h d(rho)/dh; the derivative of the lattice sum rho(h) = sum_j m_j W(r_j, h) is
-    taken by a central difference. Close to, not exactly, 2 (2.021 at h = 1.3 dx); the
+    taken by a central difference. Close to, not exactly, 2 (1.982 at h = 1.2 dx); the
     pressure force weighs every neighbour by rho / alpha, so the buffer must carry the value
     of the water it continues.
     """

@@ -17,7 +17,7 @@ water (the density solve makes rho_i = sum_j m_j W_ij), 1/2 on the straight edge
 uniform water body, 0 far away. Cells with ``S < min_support`` (default 0.5) are therefore
 left unsupported (NaN): the mapped extent follows the half-support contour, which is where
 the edge of the area the particles stand for lies, and inside it the depth is the exact
-Shepard value. An isolated particle (S <= 10 / (7 pi kappa^2) ~ 0.27 for kappa = 1.3) is
+Shepard value. An isolated particle (S <= 10 / (7 pi kappa^2) ~ 0.32 for kappa = 1.2) is
 not mapped: it carries a negligible volume.
 
 The loop gathers over the target points (iteration k writes only the sums of point k), so it

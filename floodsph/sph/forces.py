@@ -26,7 +26,7 @@ nears the wall (at 10 m spacing and 3 m depth: 0.33 m s-2 at 2 m from the wall, 
 0.1 m), so particles crowded against a wall or into a corner stuck there, at several times the
 depth around, and were shot off (seen at up to 14 m s-1 in still water between oblique walls).
 With the floor the push grows as the wall comes closer. On a lattice a half spacing from a
-straight wall the own image is at q = 0.77 (kappa = 1.3), so still water there is unchanged.
+straight wall the own image is at q = 1 / kappa = 0.83, so still water there is unchanged.
 The images of other particles keep the plain gradient: their pair axis has a component along
 the wall, and a floored gradient there would add to the pressure force along the wall what
 the real neighbours do not (it sped up the thin front of a dam break in a 100 m channel).
