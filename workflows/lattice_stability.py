@@ -100,10 +100,11 @@ def lowest_curvature(kappa: float, patch: int, eps: float = 2e-3) -> float:
     return float(np.delete(w, np.argsort(np.abs(w))[:2]).min())
 
 
-def still_lake(kappa: float, end_time: float, spacing: float = 20.0, perturbation: float = 0.02,
-               seed: int = 1, every: float = 80.0):
-    """Max particle speed [m/s] every ``every`` s of a 10 m still lake (module docstring)."""
-    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0.0, 1000.0), (0.0, 1000.0), 10.0)
+def still_lake(kappa: float, end_time: float, side: float = 1000.0, spacing: float = 20.0,
+               perturbation: float = 0.02, seed: int = 1, every: float = 80.0):
+    """(t [s], max particle speed [m/s]) every ``every`` s of a 10 m still lake on a flat,
+    frictionless, closed square of ``side`` [m] (module docstring)."""
+    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0.0, side), (0.0, side), 10.0)
     p = seed_particles(terrain, np.full(terrain.shape, 10.0), spacing, kappa)
     rng = np.random.default_rng(seed)
     p.x[:p.n] += rng.normal(0.0, perturbation, p.n)
