@@ -8,7 +8,8 @@ method notes 2.6-2.7):
 2. drift  x^{n+1} = x^n + v^{n+1/2} dt; moves across walls are reflected; particles that
           leave an open border or enter nodata are removed and counted as outflow
 3. density guess from continuity, neighbour lists, Newton-Raphson solve of rho and h
-4. forces a^{n+1} at (x^{n+1}, v^{n+1/2}): pressure + shock capturing, balanced at shores
+4. forces a^{n+1} at (x^{n+1}, v^{n+1/2}): pressure (renormalised where the lattice is
+          distorted, ``floodsph.sph.consistency``) + shock capturing, balanced at shores
           (``floodsph.sph.shore``), + bed
 5. kick   v^{n+1} = v^{n+1/2} + a^{n+1} dt / 2, then implicit Manning friction over dt
 6. next dt = cfl min h / (|v| + c)
@@ -33,7 +34,7 @@ from floodsph.boundaries.openings import cut_openings
 from floodsph.constants import RHO_WATER
 from floodsph.particles import ParticleSet
 from floodsph.sph import bed as bedmod
-from floodsph.sph import density, forces, local_steps, shore
+from floodsph.sph import consistency, density, forces, local_steps, shore
 from floodsph.sph import walls as wallmod
 from floodsph.sph.neighbours import CellGrid, NeighbourList
 from floodsph.terrain import Terrain
@@ -432,10 +433,12 @@ class FloodModel:
         bedmod.sample_bed(rows, p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
             self._blocked_pairs()
-        forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
-                                     self.nl.start, self.nl.nbr, self.blocked, self.wdist,
-                                     *self.walls_near, self.seg, self.scheme, self.shores,
+        forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, p.kxx,
+                                     p.kxy, p.kyy, self.nl.start, self.nl.nbr, self.blocked,
+                                     self.wdist, *self.walls_near, self.seg, self.scheme,
                                      self.pair_sums, p.ax, p.ay, p.divv)
+        consistency.update_renormalisation(rows, p.h, self.pair_sums, self.shores, p.kxx, p.kxy,
+                                           p.kyy)
         if self.shores:
             shore.balance_shores(rows, p.x, p.y, p.u, p.v, p.rho, p.h, self.bed, t.dx, t.dy,
                                  t.elevation, self.pair_sums, p.ax, p.ay)

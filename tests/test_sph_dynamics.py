@@ -244,9 +244,9 @@ def test_segments_beyond_reach_are_skipped_without_changing_density_or_forces():
                for i in range(p.n)]
         acc = np.empty((3, p.n))
         forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
-                                     model.nl.start, model.nl.nbr, model.blocked, wdist,
-                                     *model.walls_near, model.seg, model.scheme,
-                                     model.shores, np.empty((p.n, forces.SUMS)), *acc)
+                                     p.kxx, p.kxy, p.kyy, model.nl.start, model.nl.nbr,
+                                     model.blocked, wdist, *model.walls_near, model.seg,
+                                     model.scheme, np.empty((p.n, forces.SUMS)), *acc)
         return np.array(rho), acc
 
     rho, acc = results(model.wdist)

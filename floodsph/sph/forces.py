@@ -15,9 +15,11 @@ Option "riemann" (method notes 2.2 C, SWE-SPHysics): g rho_i^2 / (2 rho_w) in th
 term of both particles is replaced by the two-shock Riemann pressure p* = g rho_w d*^2 / 2
 (Toro) of the pair, solved along the pair axis.
 
-Both forms are antisymmetric in (i, j): internal forces conserve linear momentum exactly.
-The same loop sums the hydrostatic pressure's parts that ``floodsph.sph.shore`` uses to
-balance it where the water ends on a rising bed (no change on a flat bed).
+The pressure part of each pair is renormalised by the mean of the pair's K where the particles
+have left the lattice (``floodsph.sph.consistency``). All these forms are
+antisymmetric in (i, j): internal forces conserve linear momentum exactly. The same loop sums
+the hydrostatic pressure's parts that ``floodsph.sph.consistency`` renormalises with and that
+``floodsph.sph.shore`` uses to balance it where the water ends on a rising bed.
 Wall images (``floodsph.sph.walls``) enter the same pair terms; a particle's own images
 (across a wall, normal to it, and through a corner) with the kernel gradient held at its peak
 below q = r/h = 2/3 (:func:`floodsph.sph.kernels.dwdr_over_r_floored`). With the plain cubic
@@ -77,11 +79,13 @@ def riemann_pressure(d_l, d_r, u_l, u_r):
 
 
 @njit(parallel=True, cache=True)
-def pair_coefficients(m, rho, alpha, h, coef):
-    """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i, g A_i / 2).
+def pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, coef):
+    """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i, g A_i / 2,
+    K_i xx, xy, yy).
 
     beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
-    1 / h_i [m^-1], g A_i / 2 [m3 s-2] with the area A_i = m_i / rho_i. A particle with no
+    1 / h_i [m^-1], g A_i / 2 [m3 s-2] with the area A_i = m_i / rho_i, and the pressure
+    renormalisation K_i = M_i^-1 - I [-] of ``floodsph.sph.consistency``. A particle with no
     neighbour within its support (alpha_i = 0, possible when its h is held back by its lists)
     takes beta_i = 1, the uncorrected force (alpha_i = 2 rho_i on a lattice).
     """
@@ -90,23 +94,30 @@ def pair_coefficients(m, rho, alpha, h, coef):
         coef[i, 1] = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
         coef[i, 2] = 1.0 / h[i]
         coef[i, 3] = 0.5 * GRAVITY * m[i] / rho[i]
+        coef[i, 4] = kxx[i]
+        coef[i, 5] = kxy[i]
+        coef[i, 6] = kyy[i]
 
 
 @njit(inline="always", cache=True)
-def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, image=False):
+def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, kj, image=False):
     """Pair terms of a_i^int and of div v_i for separation r = x_i - x_j, v = v_i - v_j.
 
     j's properties (mass, density, h, ``coef`` of :func:`pair_coefficients`) are taken at
-    index j, also for j's mirror images (whose r and v the caller passes). Returns
-    (rx, ry, f, w, fd), summed by :func:`_subtract`: a_i^int takes - f r, the divergence sum
-    sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i) takes - fd, and
+    index j, also for j's mirror images (whose r and v the caller passes), except j's
+    pressure renormalisation ``kj`` = (K xx, xy, yy), reflected with the image. Returns
+    (rx, ry, fx, fy, w, fd, af), summed by :func:`_subtract`: a_i^int takes - (fx, fy), the
+    pressure part f_p r renormalised to f_p (I + (K_i + K_j) / 2) r
+    (``floodsph.sph.consistency``) plus the shock-capturing part f_v r; the divergence sum
+    sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i) takes - fd; and
     w = (g / 2) (m_j / rho_j) (beta_i F_i + beta_j F_j) [s-2 m-2] (F = (1/r) dW/dr) is the
-    pair's hydrostatic weight, for the shore terms of ``floodsph.sph.shore``. ``image``: j is
-    i's own wall image (the floored kernel gradient).
+    pair's hydrostatic weight, for the sums of ``floodsph.sph.shore`` and
+    ``floodsph.sph.consistency``; af = (m_j / rho_j) F_i [m-2], for the latter's edge test.
+    ``image``: j is i's own wall image (the floored kernel gradient).
     """
     r2 = rx * rx + ry * ry
     if r2 <= 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     r = math.sqrt(r2)
     inv_r = 1.0 / r
     if image:
@@ -119,25 +130,29 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, image=False):
     if scheme == RIEMANN:
         # axis from i to j: u_l = v_i . e, u_r = v_j . e, so u_l - u_r = -vr / r
         p_star = riemann_pressure(rho[i] / RHO_WATER, rho[j] / RHO_WATER, 0.0, vr * inv_r)
-        ci = p_star * coef[i, 0] / (rho[i] * rho[i])
-        cj = p_star * coef[j, 0] / (rho[j] * rho[j])
+        fp = m[j] * p_star * (coef[i, 0] * fi / (rho[i] * rho[i])
+                              + coef[j, 0] * fj / (rho[j] * rho[j]))
+        fv = 0.0
     else:
         # Pi_ij for approaching pairs, computed for all and zero otherwise (no jump)
         hbar = 0.5 * (h[i] + h[j])
         cbar = 0.5 * (coef[i, 1] + coef[j, 1])
         pi_ij = -cbar * min(vr, 0.0) / (0.5 * (rho[i] + rho[j])
                                         * math.sqrt(r2 + 0.01 * hbar * hbar))
-        k = 0.5 * GRAVITY / RHO_WATER
-        ci = k * coef[i, 0] + 0.5 * pi_ij
-        cj = k * coef[j, 0] + 0.5 * pi_ij
-    f = m[j] * (ci * fi + cj * fj)
+        fp = m[j] * (0.5 * GRAVITY / RHO_WATER) * (coef[i, 0] * fi + coef[j, 0] * fj)
+        fv = m[j] * 0.5 * pi_ij * (fi + fj)
+    kxx = 0.5 * fp * (coef[i, 4] + kj[0])
+    kxy = 0.5 * fp * (coef[i, 5] + kj[1])
+    kyy = 0.5 * fp * (coef[i, 6] + kj[2])
+    f = fp + fv
     w = coef[j, 3] * (coef[i, 0] * fi + coef[j, 0] * fj)
-    return rx, ry, f, w, m[j] * fi * vr
+    return (rx, ry, f * rx + kxx * rx + kxy * ry, f * ry + kxy * rx + kyy * ry, w,
+            m[j] * fi * vr, m[j] / rho[j] * fi)
 
 
 @njit(parallel=True, cache=True)
-def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, nstart, nbr, blocked, wdist, wstart,
-                          wseg, cstart, cpair, seg, scheme, shores, sums, ax, ay, divv):
+def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nstart, nbr, blocked,
+                          wdist, wstart, wseg, cstart, cpair, seg, scheme, sums, ax, ay, divv):
     """a^int and div v of the particles ``rows`` (gather form), mirror images included.
 
     Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
@@ -148,18 +163,19 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, nstart, nbr, block
     :meth:`floodsph.sph.walls.WallIndex.near_lists`; images are summed segment by segment,
     each followed by the corners it opens, as in the density summation.
 
-    With ``shores`` (a bed that is not flat), row i of ``sums`` (n, SUMS) receives particle
-    i's shore sums (columns 2-8 of :func:`_subtract`), for ``floodsph.sph.shore``; on a flat
-    bed they are not needed and not summed (20 % of the loop's time).
+    Row i of ``sums`` (n, SUMS) receives particle i's sums of :func:`_subtract` (columns 2-8,
+    then 10-11), for ``floodsph.sph.shore`` and ``floodsph.sph.consistency``; the
+    pressure renormalisation K (kxx, kxy, kyy) is the one the latter set from them at i's
+    previous force evaluation.
     """
-    coef = np.empty((x.shape[0], 4))
-    pair_coefficients(m, rho, alpha, h, coef)
+    coef = np.empty((x.shape[0], 7))
+    pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, coef)
     for k in prange(rows.shape[0]):
         i = rows[k]
         xi = x[i]
         yi = y[i]
         hi = h[i]
-        acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         h_reach = hi  # the largest h of i and its neighbours: no image beyond 2 h_reach
         for q in range(nstart[i], nstart[i + 1]):
             j = nbr[q]
@@ -170,54 +186,53 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, nstart, nbr, block
             if rx * rx + ry * ry >= hm * hm or blocked[q]:
                 continue
             acc = _subtract(acc, i, j, rho, pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m,
-                                                       rho, h, coef, scheme), shores)
+                                                       rho, h, coef, scheme,
+                                                       (coef[j, 4], coef[j, 5], coef[j, 6])))
         c = cstart[i]
         for w in range(wstart[i], wstart[i + 1]):
             s = wseg[w]
             if wdist[w] < 2.0 * h_reach + SIGHT_SLACK:
                 acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
-                                       seg, s, -1, wdist[w], scheme, shores)
+                                       seg, s, -1, wdist[w], scheme)
             while c < cstart[i + 1] and cpair[c, 0] == s:
                 acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
-                                       seg, s, cpair[c, 1], 0.0, scheme, shores)
+                                       seg, s, cpair[c, 1], 0.0, scheme)
                 c += 1
         ax[i] = acc[0]
         ay[i] = acc[1]
-        if shores:
-            for c in range(SUMS):
-                sums[i, c] = acc[2 + c]
+        for c in range(7):
+            sums[i, c] = acc[2 + c]
+        sums[i, 7] = acc[10]
+        sums[i, 8] = acc[11]
         divv[i] = coef[i, 0] * acc[9] / rho[i]  # (2 / alpha_i) fd, with beta's fallback
 
 
-SUMS = 7  # columns of the shore sums: D (x, y), E (x, y), g M (xx, xy, yy)
+SUMS = 9  # columns of the sums: D (x, y), E (x, y), g M (xx, xy, yy), e (x, y)
 
 
 @njit(inline="always", cache=True)
-def _subtract(acc, i, j, rho, t, shores):
-    """Subtract the terms t = (rx, ry, f, w, fd) of :func:`pair_force` for the pair of i and
-    j (or j's image) from i's sums ``acc``, a tuple, with d = rho / rho_w:
+def _subtract(acc, i, j, rho, t):
+    """Subtract the terms t = (rx, ry, fx, fy, w, fd) of :func:`pair_force` for the pair of i
+    and j (or j's image) from i's sums ``acc``, a tuple, with d = rho / rho_w:
 
-    0-1: a^int = - sum f r [m s-2];
+    0-1: a^int = - sum (fx, fy) [m s-2];
     2-3: D = - sum w (d_j - d_i) r [m s-2], the hydrostatic pressure force's difference part;
     4-5: E = - sum w r [s-2], its push per metre of i's own depth (a^p = D + d_i E);
     6-8: g M = - sum w r r^T, as xx, xy, yy [s-2] (M = I in a full support);
-    9: the divergence sum, - sum fd.
-
-    Terms 2-8 only with ``shores``.
+    9: the divergence sum, - sum fd;
+    10-11: e = - sum (m_j / rho_j) F(r, h_i) r [m-1], the first moment of i's own kernel
+    gradient, 0 in a full support (``floodsph.sph.consistency``).
     """
-    rx, ry, f, w, fd = t
-    if not shores:
-        return (acc[0] - f * rx, acc[1] - f * ry, acc[2], acc[3], acc[4], acc[5], acc[6],
-                acc[7], acc[8], acc[9] - fd)
+    rx, ry, fx, fy, w, fd, af = t
     wd = w * (rho[j] - rho[i]) * (1.0 / RHO_WATER)
-    return (acc[0] - f * rx, acc[1] - f * ry, acc[2] - wd * rx, acc[3] - wd * ry,
+    return (acc[0] - fx, acc[1] - fy, acc[2] - wd * rx, acc[3] - wd * ry,
             acc[4] - w * rx, acc[5] - w * ry, acc[6] - w * rx * rx, acc[7] - w * rx * ry,
-            acc[8] - w * ry * ry, acc[9] - fd)
+            acc[8] - w * ry * ry, acc[9] - fd, acc[10] - af * rx, acc[11] - af * ry)
 
 
 @njit(inline="always", cache=True)
 def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, seg, s, s2, ds,
-                     scheme, shores):
+                     scheme):
     """Subtract from ``acc`` (:func:`_subtract`) the pair terms on particle i of the images of
     i and of its unblocked neighbours about segment s (s2 < 0) or about the corner of s and
     s2.
@@ -232,7 +247,7 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
             t = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
         else:
             t = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-        acc = _subtract(acc, i, i, rho, t, shores)
+        acc = _subtract(acc, i, i, rho, t)
     for q in range(nstart[i], nstart[i + 1]):
         if blocked[q] or ds >= 2.0 * max(hi, h[nbr[q]]) + SIGHT_SLACK:
             continue
@@ -240,7 +255,7 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
             t = _image_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, scheme)
         else:
             t = _corner_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-        acc = _subtract(acc, i, nbr[q], rho, t, shores)
+        acc = _subtract(acc, i, nbr[q], rho, t)
     return acc
 
 
@@ -248,20 +263,21 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
 def _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme):
     xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
     if not ok:
-        return 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     _, _, _, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
     vn = u[j] * nx + v[j] * ny
     um = u[j] - 2.0 * vn * nx
     vm = v[j] - 2.0 * vn * ny
+    kj = _reflect(coef[j, 4], coef[j, 5], coef[j, 6], nx, ny)
     return pair_force(x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, i, j, m, rho, h, coef, scheme,
-                      image=j == i)
+                      kj, image=j == i)
 
 
 @njit(inline="always", cache=True)
 def _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s1, s2, scheme):
     xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
     if not ok:
-        return 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     # two reflections of the velocity: about s1's normal, then s2's
     _, _, _, n1x, n1y = mirror(x[j], y[j], seg[s1, 0], seg[s1, 1], seg[s1, 2], seg[s1, 3])
     _, _, _, n2x, n2y = mirror(x[j], y[j], seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
@@ -271,8 +287,24 @@ def _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s1, s2, scheme):
     vn = um * n2x + vm * n2y
     um -= 2.0 * vn * n2x
     vm -= 2.0 * vn * n2y
+    kxx, kxy, kyy = _reflect(coef[j, 4], coef[j, 5], coef[j, 6], n1x, n1y)
+    kj = _reflect(kxx, kxy, kyy, n2x, n2y)
     return pair_force(x[i] - xc, y[i] - yc, u[i] - um, v[i] - vm, i, j, m, rho, h, coef, scheme,
-                      image=j == i)
+                      kj, image=j == i)
+
+
+@njit(inline="always", cache=True)
+def _reflect(kxx, kxy, kyy, nx, ny):
+    """The symmetric tensor K = (kxx, kxy, kyy) reflected about a line of unit normal n:
+    R K R with R = I - 2 n n^T."""
+    rxx = 1.0 - 2.0 * nx * nx
+    rxy = -2.0 * nx * ny
+    ryy = 1.0 - 2.0 * ny * ny
+    axx = rxx * kxx + rxy * kxy  # A = R K
+    axy = rxx * kxy + rxy * kyy
+    ayx = rxy * kxx + ryy * kxy
+    ayy = rxy * kxy + ryy * kyy
+    return axx * rxx + axy * rxy, axx * rxy + axy * ryy, ayx * rxy + ayy * ryy
 
 
 @njit(parallel=True, cache=True)
