@@ -56,7 +56,7 @@ import math
 from numba import njit, prange
 
 from floodsph.constants import GRAVITY
-from floodsph.sph.shore import FULL_SUPPORT
+from floodsph.sph.shore import FULL_SUPPORT, moment_matrix
 
 EDGE = 0.1  # |e| h at and above which i's own support counts as cut: no renormalisation
 DET_MIN = 0.5  # det M below which a support is too distorted to renormalise
@@ -79,10 +79,7 @@ def update_renormalisation(rows, h, sums, shores, kxx, kxy, kyy):
         push = math.sqrt(sums[i, 2] * sums[i, 2] + sums[i, 3] * sums[i, 3])
         if shores and push * h[i] >= FULL_SUPPORT * GRAVITY:
             continue
-        mxx = sums[i, 4] / GRAVITY
-        mxy = sums[i, 5] / GRAVITY
-        myy = sums[i, 6] / GRAVITY
-        det = mxx * myy - mxy * mxy
+        mxx, mxy, myy, det = moment_matrix(sums, i)
         if det < DET_MIN:
             continue
         s = math.sqrt(det)

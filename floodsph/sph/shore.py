@@ -62,6 +62,16 @@ DET_MIN = 0.02  # det M below which a particle's support is too empty to renorma
 FULL_SUPPORT = 0.01  # |E| h / g below which a support counts as full: not at an edge
 
 
+@njit(inline="always", cache=True)
+def moment_matrix(sums, i):
+    """(M_xx, M_xy, M_yy, det M) [-] of particle i, from the g M of its ``sums`` (columns 4-6
+    of ``floodsph.sph.forces.internal_acceleration``)."""
+    mxx = sums[i, 4] / GRAVITY
+    mxy = sums[i, 5] / GRAVITY
+    myy = sums[i, 6] / GRAVITY
+    return mxx, mxy, myy, mxx * myy - mxy * mxy
+
+
 @njit(parallel=True, cache=True)
 def balance_shores(rows, x, y, u, v, rho, h, bed, dx, dy, elevation, sums, ax, ay):
     """Correct a^int (``ax``, ``ay``) of the particles ``rows`` at shores (module docstring).
@@ -88,10 +98,7 @@ def balance_shores(rows, x, y, u, v, rho, h, bed, dx, dy, elevation, sums, ax, a
             continue
         ax[i] -= cut * ex
         ay[i] -= cut * ey
-        mxx = sums[i, 4] / GRAVITY
-        mxy = sums[i, 5] / GRAVITY
-        myy = sums[i, 6] / GRAVITY
-        det = mxx * myy - mxy * mxy
+        mxx, mxy, myy, det = moment_matrix(sums, i)
         if det < DET_MIN:
             continue
         gamma = cut / d
