@@ -16,8 +16,8 @@ term of both particles is replaced by the two-shock Riemann pressure p* = g rho_
 (Toro) of the pair, solved along the pair axis.
 
 The pressure part of each pair is renormalised by the mean of the pair's K where the particles
-have left the lattice (``floodsph.sph.consistency``). All these forms are
-antisymmetric in (i, j): internal forces conserve linear momentum exactly. The same loop sums
+have left the lattice (``floodsph.sph.consistency``). All these forms are antisymmetric in
+(i, j): internal forces conserve linear momentum exactly. The same loop sums
 the hydrostatic pressure's parts that ``floodsph.sph.consistency`` renormalises with and that
 ``floodsph.sph.shore`` uses to balance it where the water ends on a rising bed.
 Wall images (``floodsph.sph.walls``) enter the same pair terms; a particle's own images
@@ -85,7 +85,7 @@ def pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, coef):
 
     beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
     1 / h_i [m^-1], g A_i / 2 [m3 s-2] with the area A_i = m_i / rho_i, and the pressure
-    renormalisation K_i = M_i^-1 - I [-] of ``floodsph.sph.consistency``. A particle with no
+    renormalisation K_i [-] of ``floodsph.sph.consistency``. A particle with no
     neighbour within its support (alpha_i = 0, possible when its h is held back by its lists)
     takes beta_i = 1, the uncorrected force (alpha_i = 2 rho_i on a lattice).
     """
