@@ -73,11 +73,9 @@ def update_renormalisation(rows, h, sums, shores, kxx, kxy, kyy):
         kxx[i] = 0.0
         kxy[i] = 0.0
         kyy[i] = 0.0
-        e = math.sqrt(sums[i, 7] * sums[i, 7] + sums[i, 8] * sums[i, 8])
-        if e * h[i] >= EDGE:
+        if math.hypot(sums[i, 7], sums[i, 8]) * h[i] >= EDGE:
             continue
-        push = math.sqrt(sums[i, 2] * sums[i, 2] + sums[i, 3] * sums[i, 3])
-        if shores and push * h[i] >= FULL_SUPPORT * GRAVITY:
+        if shores and math.hypot(sums[i, 2], sums[i, 3]) * h[i] >= FULL_SUPPORT * GRAVITY:
             continue
         mxx, mxy, myy, det = moment_matrix(sums, i)
         if det < DET_MIN:
