@@ -26,12 +26,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from floodsph import wall_seeding
 from floodsph.boundaries.junctions import split_at_junctions
 from floodsph.boundaries.nodata_walls import nodata_polylines, settle_seeds
 from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
 from floodsph.boundaries.open_edges import OpenEdges
 from floodsph.boundaries.openings import cut_openings
-from floodsph.constants import RHO_WATER
+from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.particles import ParticleSet
 from floodsph.sph import bed as bedmod
 from floodsph.sph import consistency, density, forces, local_steps, shore
@@ -153,7 +154,8 @@ class FloodModel:
         self.volume_out = 0.0
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
                          "wall_reflections": 0, "density_unconverged": 0,
-                         "density_capped": 0, "density_held": 0, "particle_updates": 0}
+                         "density_capped": 0, "density_held": 0, "particle_updates": 0,
+                         "seeds_settled": 0, "settle_steps": 0}
         self.bed = np.empty((0, 7))
         self.pair_sums = np.empty((0, forces.SUMS))
         self.shores = bool(np.ptp(terrain.elevation) > 0.0)  # a flat bed has no shore to balance
@@ -165,7 +167,9 @@ class FloodModel:
             boundary.apply(self, 0.0)
         self._settle_seeds()
         self._remove_outside(nodata=closed_edges is False)
+        rho_seed = self.particles.rho.copy()
         self._interactions(settle=True)
+        self.volume_seed_adjustment = self._settle_at_walls(rho_seed)
         self.dt = self.stable_dt()
 
     def __repr__(self) -> str:
@@ -335,6 +339,72 @@ class FloodModel:
         if lost.any():
             self.volume_out += float(p.m[lost].sum() / RHO_WATER)
             p.keep(~lost)
+
+    def _settle_at_walls(self, rho_seed: np.ndarray) -> float:
+        """Settle the seeds of still water next to walls, then match their depth to the seeded
+        rho_seed / rho_w (``floodsph.wall_seeding``); return the volume change [m3]."""
+        idx = self._wall_seeds(rho_seed)
+        self.counters["seeds_settled"] = int(idx.size)
+        if idx.size == 0:
+            return 0.0
+        self._settle(idx)
+        v0 = self.particles.volume()
+        self._match_masses(idx, rho_seed[idx])
+        return self.particles.volume() - v0
+
+    def _wall_seeds(self, rho_seed: np.ndarray) -> np.ndarray:
+        """Indices of the lattice seeds (m = rho_seed spacing^2) near a wall, out of open
+        boundaries' zones, in still water (``wall_seeding.still_water``) and enclosed within
+        ``wall_seeding.ENCLOSURE`` h (``wall_seeding.enclosed_seeds``)."""
+        p = self.particles
+        dx = self.numerics.spacing
+        n = p.n
+        candidate = np.abs(p.m - rho_seed * dx * dx) <= 1e-9 * p.m
+        candidate &= np.diff(self.walls_near[0][:n + 1]) > 0
+        for boundary in self.boundaries:
+            candidate &= ~boundary.protected(p.x, p.y)
+        rows = np.flatnonzero(candidate)
+        still = np.empty(rows.size, dtype=np.bool_)
+        wall_seeding.still_water(rows, self.nl.start, self.nl.nbr, n, p.u, p.v, self.bed[:n, 0],
+                                 rho_seed / RHO_WATER, wall_seeding.LEVEL_TOLERANCE, still)
+        wstart, wseg = self.wall_index.near_lists(p.x, p.y, p.h, np.zeros(n + 1, dtype=np.int64),
+                                                  np.zeros(0, dtype=np.int64),
+                                                  wall_seeding.ENCLOSURE)[:2]
+        return wall_seeding.enclosed_seeds(p.x, p.y, wall_seeding.ENCLOSURE * p.h, rows[still],
+                                           dx, wstart, wseg, self.seg)
+
+    def _settle(self, idx: np.ndarray) -> None:
+        """Move the particles ``idx`` by a dt^2 / 2 per round, along their acceleration (walls
+        reflecting), each at most ``wall_seeding.MAX_SHIFT`` spacings from its seed, the others
+        held, until |a| < ``wall_seeding.SETTLED`` g or for ``wall_seeding.SETTLE_STEPS``
+        rounds; dt is the CFL step."""
+        p = self.particles
+        x0, y0 = p.x[idx].copy(), p.y[idx].copy()
+        u, v = np.zeros(p.n), np.zeros(p.n)
+        limit = wall_seeding.MAX_SHIFT * self.numerics.spacing
+        taken = 0
+        while (taken < wall_seeding.SETTLE_STEPS
+               and np.hypot(p.ax[idx], p.ay[idx]).max() >= wall_seeding.SETTLED * GRAVITY):
+            dt = self.stable_dt()
+            u[idx], v[idx] = 0.5 * dt * p.ax[idx], 0.5 * dt * p.ay[idx]
+            wallmod.drift(p.x, p.y, u, v, dt, *self.walls_near[:2], self.seg)
+            p.x[idx], p.y[idx] = wall_seeding.clamp_shift(p.x[idx], p.y[idx], x0, y0, limit)
+            self._interactions(settle=True)
+            taken += 1
+        self.counters["settle_steps"] = taken
+
+    def _match_masses(self, idx: np.ndarray, rho_target: np.ndarray) -> None:
+        """Jacobi iteration m_i <- m_i rho_target_i / rho_i on the particles ``idx``, each
+        mass kept within [``MASS_MIN``, ``MASS_MAX``] times its start (``wall_seeding``)."""
+        p = self.particles
+        m0 = p.m[idx].copy()
+        for _ in range(wall_seeding.ROUNDS):
+            ratio = rho_target / p.rho[idx]
+            if np.abs(ratio - 1.0).max() < wall_seeding.TOLERANCE:
+                break
+            p.m[idx] = np.clip(p.m[idx] * ratio, wall_seeding.MASS_MIN * m0,
+                               wall_seeding.MASS_MAX * m0)
+            self._interactions(settle=True)
 
     def _remove_outside(self, nodata: bool) -> None:
         """Remove (and count as outflow) particles off the grid, and in nodata cells if

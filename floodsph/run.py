@@ -121,6 +121,12 @@ def run_scenario(
         log.info("run folder %s; %d particles, spacing %g m", out, inputs.particles.n,
                  inputs.spacing_m)
         model = build_model(scenario, inputs)
+        manifest["seeds_settled"] = model.counters["seeds_settled"]
+        manifest["volume_seed_adjustment_m3"] = model.volume_seed_adjustment
+        if model.counters["seeds_settled"]:
+            log.info("%d seeds settled next to walls in %d rounds; volume adjusted by %.6g m3",
+                     model.counters["seeds_settled"], model.counters["settle_steps"],
+                     model.volume_seed_adjustment)
         probes, sim = _simulation(scenario, inputs, model, out, max_steps, progress, callbacks)
         sim.run()
         for probe in probes:
@@ -262,7 +268,8 @@ def _simulation(scenario, inputs, model, out, max_steps, progress, extra):
     from floodsph.schedules import TimeInterval, WallTimeInterval
     from floodsph.simulation import Simulation
 
-    mass = MassBalance(out / MASS_BALANCE_NAME, inputs.volume_initial_m3)
+    mass = MassBalance(out / MASS_BALANCE_NAME,
+                       inputs.volume_initial_m3 + model.volume_seed_adjustment)
     bar = Progress(scenario.end_time_s, enabled=progress)
     recorders = Recorders(scenario, inputs.terrain, inputs.gauges, out)
     callbacks = [

@@ -189,7 +189,8 @@ def test_the_slivers_inside_the_walls_are_seeded_and_bring_the_water_up_to_them(
 
 def test_oblique_nodata_walls_hold_the_water():
     """A lake in a basin bounded by 30-degree staircases of nodata, simplified to a few
-    chords: nothing is lost at construction, mass is exact, and after 40 s of the sloshing
+    chords: nothing is lost at construction (the seeds settled at the walls change the volume
+    by the reported adjustment, measured +0.29 %), mass is exact, and after 40 s of the sloshing
     the seeding gap at the walls starts, no particle has left the walls' inside (a valid
     cell, or a nodata cell next to one)."""
     terrain, model, volume = lake_model()
@@ -197,6 +198,8 @@ def test_oblique_nodata_walls_hold_the_water():
     assert model.seg.shape[0] - 4 < 0.35 * stair  # the 4 closed grid sides included
     n0 = model.particles.n
     assert model.volume_out == 0.0
+    assert abs(model.volume_seed_adjustment) < 0.005 * volume  # seeds settled at the walls
+    volume += model.volume_seed_adjustment
     assert abs(model.volume() - volume) < 1e-9 * volume
     while model.t < 40.0:
         model.step()
@@ -210,10 +213,10 @@ def test_oblique_nodata_walls_hold_the_water():
 
 
 @pytest.mark.xfail(strict=True, reason="issue 2: along oblique walls still water does not stay "
-                   "still: measured p95 0.15 m/s, max 1.5 m/s at 20 s (0.19 and 1.2 m/s at "
-                   "100 s). Where the lattice meets an oblique wall the mirror images leave the "
-                   "depth off, and at the bends between chords images switch on and off as "
-                   "particles pass")
+                   "still: measured p95 0.16 m/s, max 0.95 m/s at 20 s (0.23 and 1.4 m/s at "
+                   "100 s), with the seeds at the walls settled. The fastest particles are "
+                   "where the chords bend (one-cell jogs between chords, the lake's ends at "
+                   "the grid border): there images switch on and off as particles pass")
 def test_lake_at_rest_between_oblique_nodata_walls():
     """The method's lake-at-rest target along walls: max speed below 1 cm/s."""
     _, model, _ = lake_model()

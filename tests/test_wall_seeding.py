@@ -1,0 +1,111 @@
+"""Seeds next to oblique walls: settled and matched to the seeded depth at set-up
+(``floodsph.wall_seeding``), so that still water along such walls stays still."""
+
+import numpy as np
+import pytest
+from sph_cases import lattice, model_on, particles_with_depth, run_until
+
+from floodsph import wall_seeding
+from floodsph.constants import RHO_WATER
+from floodsph.model import FloodModel, Numerics
+from floodsph.sph import walls as wallmod
+from floodsph.terrain import Terrain
+
+
+def turned_rectangle(angle_deg, centre=(200.0, 200.0), half=(150.0, 90.0)):
+    """A closed wall polyline: a 300 m x 180 m rectangle turned by ``angle_deg``."""
+    t = np.radians(angle_deg)
+    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * np.array(half)
+    turn = np.array([[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]])
+    return corners @ turn.T + np.array(centre)
+
+
+def lake_in(polyline, depth=2.0, dx=5.0):
+    """Still water ``depth`` [m] on a flat 400 m square, seeded on the lattice inside the
+    closed wall ``polyline``."""
+    from matplotlib.path import Path
+
+    x, y = lattice(0.0, 400.0, 0.0, 400.0, dx)
+    inside = Path(polyline).contains_points(np.column_stack([x, y]))
+    p = particles_with_depth(x, y, np.where(inside, depth, 0.0), dx, Numerics.kappa)
+    terrain = Terrain(np.zeros((80, 80)), 5.0, 5.0, manning=0.0)
+    return FloodModel(terrain, p, Numerics(spacing=dx), walls=[polyline])
+
+
+@pytest.fixture(scope="module")
+def turned_lake():
+    """The lake in the rectangle turned by 30 degrees, its seeded volume, and its seeds."""
+    polyline = turned_rectangle(30.0)
+    model = lake_in(polyline)
+    seeded = float(np.count_nonzero(model.particles.m)) * 2.0 * 25.0
+    return model, seeded
+
+
+def test_along_an_oblique_wall_the_seeds_read_the_seeded_depth(turned_lake):
+    """Without settling and matching, seeds next to the 30-degree walls read up to 0.84 m off
+    the 2 m of water (the images crowd or leave gaps); after, within 2 % (measured 1.2 %)."""
+    model, _ = turned_lake
+    assert np.abs(model.depth() - 2.0).max() < 0.04
+
+
+def test_the_adjustment_is_reported_and_small(turned_lake):
+    """The seeds' volume changes by the reported ``volume_seed_adjustment`` only (measured
+    +41 m3 of 107,900 m3), and masses move by at most the bounds."""
+    model, seeded = turned_lake
+    assert model.volume() == pytest.approx(seeded + model.volume_seed_adjustment, rel=1e-12)
+    assert 0.0 < abs(model.volume_seed_adjustment) < 0.005 * seeded
+    m = model.particles.m / (RHO_WATER * 2.0 * 25.0)
+    assert m.min() >= wall_seeding.MASS_MIN - 1e-12 and m.max() <= wall_seeding.MASS_MAX + 1e-12
+
+
+def test_still_water_along_an_oblique_wall_stays_nearly_still(turned_lake):
+    """After 100 s the 95th-percentile speed is below 1.5 cm/s (measured 0.9 cm/s; 3.7 cm/s
+    without the set-up, and 7.4 cm/s at 20 s) and the fastest particle below 5 cm/s
+    (measured 3.6; 4.6 without). The issue's 1 cm/s for every particle is not met."""
+    model, seeded = turned_lake
+    run_until(model, 100.0)
+    speed = np.hypot(model.particles.u, model.particles.v)
+    assert np.percentile(speed, 95) < 0.015
+    assert speed.max() < 0.05
+    assert model.volume() == pytest.approx(seeded + model.volume_seed_adjustment, rel=1e-12)
+
+
+def test_walls_along_the_lattice_change_nothing():
+    """In a box whose walls run half a spacing from the lattice rows, and around a building
+    aligned with it, the seeds are already exact: no seed moves and no mass changes."""
+    def depth(x, y):
+        inside = (x > 300) & (x < 500) & (y > 200) & (y < 400)
+        return np.where(inside, 0.0, 3.0)
+
+    building = np.array([[300.0, 200.0], [500.0, 200.0], [500.0, 400.0], [300.0, 400.0],
+                         [300.0, 200.0]])
+    model = model_on(lambda x, y: 0 * x, (0, 800), (0, 600), 10.0, depth, 10.0,
+                     walls=[building])
+    x, y = lattice(0.0, 800.0, 0.0, 600.0, 10.0)
+    keep = depth(x, y) > 0
+    p = model.particles
+    assert model.volume_seed_adjustment == 0.0
+    np.testing.assert_array_equal(np.sort(p.x + 1e3 * p.y), np.sort(x[keep] + 1e3 * y[keep]))
+    np.testing.assert_array_equal(p.m, RHO_WATER * 3.0 * 100.0)
+
+
+def test_seeds_whose_support_reaches_dry_ground_are_not_enclosed():
+    """Water against a wall along x = 51 m (1.5 m from the first lattice column), from a free
+    edge at y = 0 to a free shore at y = 100 m: the seeds next to the wall and within
+    ``ENCLOSURE`` h of either see dry lattice nodes and are left as they are; the others are
+    enclosed."""
+    dx, h = 5.0, Numerics.kappa * 5.0
+    x, y = lattice(0.0, 200.0, 0.0, 200.0, dx)
+    wet = (x > 51.0) & (y < 100.0)
+    x, y = x[wet], y[wet]
+    seg = wallmod.segments_from_polylines([np.array([[51.0, -10.0], [51.0, 210.0]])])
+    index = wallmod.WallIndex(seg, (0.0, 0.0, 200.0, 200.0), bucket=2.0 * h)
+    n = x.size
+    reach = wall_seeding.ENCLOSURE * h
+    wstart, wseg = index.near_lists(x, y, np.full(n, h), np.zeros(n + 1, dtype=np.int64),
+                                    np.zeros(0, dtype=np.int64), wall_seeding.ENCLOSURE)[:2]
+    near = np.flatnonzero(np.diff(wstart) > 0)
+    enclosed = wall_seeding.enclosed_seeds(x, y, np.full(n, reach), near, dx, wstart, wseg, seg)
+    inner = (y[near] + dx / 2 >= reach) & (100.0 + dx / 2 - y[near] >= reach)  # first dry nodes
+    assert inner.any() and (~inner).any()
+    np.testing.assert_array_equal(np.sort(enclosed), np.sort(near[inner]))
