@@ -1,42 +1,27 @@
 """Seeds next to oblique walls: settled and matched to the seeded depth at set-up
 (``floodsph.wall_seeding``), so that still water along such walls stays still."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
-from sph_cases import lattice, model_on, particles_with_depth, run_until
+from conftest import load_workflow
+from sph_cases import lattice, model_on, run_until
 
 from floodsph import wall_seeding
 from floodsph.constants import RHO_WATER
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import Numerics
 from floodsph.sph import walls as wallmod
-from floodsph.terrain import Terrain
 
-
-def turned_rectangle(angle_deg, centre=(200.0, 200.0), half=(150.0, 90.0)):
-    """A closed wall polyline: a 300 m x 180 m rectangle turned by ``angle_deg``."""
-    t = np.radians(angle_deg)
-    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * np.array(half)
-    turn = np.array([[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]])
-    return corners @ turn.T + np.array(centre)
-
-
-def lake_in(polyline, depth=2.0, dx=5.0):
-    """Still water ``depth`` [m] on a flat 400 m square, seeded on the lattice inside the
-    closed wall ``polyline``."""
-    from matplotlib.path import Path
-
-    x, y = lattice(0.0, 400.0, 0.0, 400.0, dx)
-    inside = Path(polyline).contains_points(np.column_stack([x, y]))
-    p = particles_with_depth(x, y, np.where(inside, depth, 0.0), dx, Numerics.kappa)
-    terrain = Terrain(np.zeros((80, 80)), 5.0, 5.0, manning=0.0)
-    return FloodModel(terrain, p, Numerics(spacing=dx), walls=[polyline])
+STILL = load_workflow("still_water_at_walls",
+                      Path(__file__).parents[1] / "workflows" / "still_water_at_walls.py")
 
 
 @pytest.fixture(scope="module")
 def turned_lake():
-    """The lake in the rectangle turned by 30 degrees, its seeded volume, and its seeds."""
-    polyline = turned_rectangle(30.0)
-    model = lake_in(polyline)
+    """2 m of water inside a 300 m x 180 m rectangle of walls turned by 30 degrees (5 m
+    spacing), and its seeded volume."""
+    model, _ = STILL.build("turned-rectangle")
     seeded = float(np.count_nonzero(model.particles.m)) * 2.0 * 25.0
     return model, seeded
 
