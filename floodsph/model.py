@@ -101,7 +101,10 @@ class FloodModel:
     terrain : Terrain
     particles : ParticleSet
         Seeded particles (local coordinates) with m, rho = rho_w d and h = kappa dx set; their
-        density and smoothing length are solved on construction.
+        density and smoothing length are solved on construction. Seeds of still water next to
+        walls are also settled there, and their masses matched to the seeded depth
+        (``floodsph.wall_seeding``): the set is changed in place, and
+        ``volume_seed_adjustment`` [m3] is the volume change.
     numerics : Numerics
     walls : sequence of (k, 2) arrays
         Polylines in local coordinates that water cannot cross.
@@ -363,32 +366,37 @@ class FloodModel:
         candidate &= np.diff(self.walls_near[0][:n + 1]) > 0
         for boundary in self.boundaries:
             candidate &= ~boundary.protected(p.x, p.y)
+        everyone = np.arange(n, dtype=np.int64)
+        still = np.empty(n, dtype=np.bool_)
+        wall_seeding.still_water(everyone, self.nl.start, self.nl.nbr, n, p.u, p.v,
+                                 self.bed[:n, 0], rho_seed / RHO_WATER,
+                                 wall_seeding.LEVEL_TOLERANCE, still)
         rows = np.flatnonzero(candidate)
-        still = np.empty(rows.size, dtype=np.bool_)
-        wall_seeding.still_water(rows, self.nl.start, self.nl.nbr, n, p.u, p.v, self.bed[:n, 0],
-                                 rho_seed / RHO_WATER, wall_seeding.LEVEL_TOLERANCE, still)
+        calm = np.empty(rows.size, dtype=np.bool_)
+        wall_seeding.with_neighbours(rows, self.nl.start, self.nl.nbr, n, still, calm)
+        rows = rows[calm]
         wstart, wseg = self.wall_index.near_lists(p.x, p.y, p.h, np.zeros(n + 1, dtype=np.int64),
                                                   np.zeros(0, dtype=np.int64),
                                                   wall_seeding.ENCLOSURE)[:2]
-        return wall_seeding.enclosed_seeds(p.x, p.y, wall_seeding.ENCLOSURE * p.h, rows[still],
+        return wall_seeding.enclosed_seeds(p.x, p.y, wall_seeding.ENCLOSURE * p.h, rows,
                                            dx, wstart, wseg, self.seg)
 
     def _settle(self, idx: np.ndarray) -> None:
         """Move the particles ``idx`` by a dt^2 / 2 per round, along their acceleration (walls
-        reflecting), each at most ``wall_seeding.MAX_SHIFT`` spacings from its seed, the others
-        held, until |a| < ``wall_seeding.SETTLED`` g or for ``wall_seeding.SETTLE_STEPS``
-        rounds; dt is the CFL step."""
+        reflecting), with dt the model's CFL step, each at most ``wall_seeding.MAX_SHIFT``
+        spacings in all from its seed, the others held, until |a| < ``wall_seeding.SETTLED`` g
+        or for ``wall_seeding.SETTLE_STEPS`` rounds."""
         p = self.particles
         x0, y0 = p.x[idx].copy(), p.y[idx].copy()
-        u, v = np.zeros(p.n), np.zeros(p.n)
+        mx, my = np.zeros(p.n), np.zeros(p.n)
         limit = wall_seeding.MAX_SHIFT * self.numerics.spacing
         taken = 0
         while (taken < wall_seeding.SETTLE_STEPS
                and np.hypot(p.ax[idx], p.ay[idx]).max() >= wall_seeding.SETTLED * GRAVITY):
-            dt = self.stable_dt()
-            u[idx], v[idx] = 0.5 * dt * p.ax[idx], 0.5 * dt * p.ay[idx]
-            wallmod.drift(p.x, p.y, u, v, dt, *self.walls_near[:2], self.seg)
-            p.x[idx], p.y[idx] = wall_seeding.clamp_shift(p.x[idx], p.y[idx], x0, y0, limit)
+            dt = np.full(idx.size, self.stable_dt())
+            mx[idx], my[idx] = wall_seeding.limited_move(p.ax[idx], p.ay[idx], dt, p.x[idx] - x0,
+                                                         p.y[idx] - y0, limit)
+            wallmod.drift(p.x, p.y, mx, my, 1.0, *self.walls_near[:2], self.seg)
             self._interactions(settle=True)
             taken += 1
         self.counters["settle_steps"] = taken

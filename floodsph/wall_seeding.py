@@ -17,16 +17,20 @@ north wall lies 3.6 m beyond it, and the dam break's L1 depth error was 1.83 % (
 When the model is set up (``FloodModel._settle_at_walls``), the seeds next to walls that are
 in still water and enclosed (below) are therefore
 
-1. settled: moved by a_i dt^2 / 2 per round (dt the CFL step), along the acceleration as in
-   a steepest descent of the SPH energy, with the other particles held, walls reflecting the
-   moves, each seed at most ``MAX_SHIFT`` spacings from where it was seeded, until
-   |a_i| < ``SETTLED`` g or for ``SETTLE_STEPS`` rounds;
+1. settled: moved by a_i dt^2 / 2 per round, with dt the model's CFL step, along the
+   acceleration as in a steepest descent of the SPH energy, with the other particles held and
+   walls reflecting the moves, each seed at most ``MAX_SHIFT`` spacings in all from where it
+   was seeded (:func:`limited_move`), until |a_i| < ``SETTLED`` g or for ``SETTLE_STEPS``
+   rounds. Each seed's own step cfl h_i / sqrt(g d_i), longer than the model's where the
+   water is deeper or h longer elsewhere, settled the building of
+   ``workflows/still_water_at_walls.py`` worse: 95th-percentile speed 0.108 m/s after 200 s,
+   against 0.062;
 2. matched: m_i <- m_i d*_i / d_i (Jacobi), with d* the seeded depth and d the SPH depth of
    the density solve, until max |d_i / d*_i - 1| < ``TOLERANCE`` or for ``ROUNDS`` rounds,
    each mass within [``MASS_MIN``, ``MASS_MAX``] times its seeded value.
 
 In the lake above (300 rounds of settling), the depth is then within 1.2 % of 2 m and the
-95th-percentile speed 0.018 / 0.009 / 0.007 m/s after 20 / 100 / 200 s, 0.014 m/s at most
+95th-percentile speed 0.018 / 0.009 / 0.006 m/s after 20 / 100 / 200 s, 0.014 m/s at most
 after 200 s; the Ritter run above has an L1 error of 0.66 %. In the lake, settling alone gave
 0.022 / 0.012 / 0.014 m/s (depth within 2 %); 100 rounds 0.019 / 0.009 / 0.009, 1,000 rounds
 0.017 / 0.007 / 0.006. Matching alone (masses within 0.8-1.25 times) gave
@@ -37,8 +41,10 @@ reached 12.8 m/s; after settling, the masses of the lake above stay within 0.95-
 Which seeds: lattice seeds (m = rho_w d* dx^2: not inflow or split particles) with a wall in
 their near list, out of open boundaries' zones, that are
 
-* still (:func:`still_water`): they and their neighbours at rest, with seeded depths and bed
-  elevations within ``LEVEL_TOLERANCE`` of the seed's depth. Where the water flows, or its
+* still (:func:`still_water`, :func:`with_neighbours`): every particle within two
+  neighbour lists of the seed (about 4.4 h) is at rest, and its neighbours' seeded depths and
+  bed elevations differ from its own by at most ``LEVEL_TOLERANCE`` times its depth. Where
+  the water flows, or its
   depth or the bed changes across the kernel (a lake on a slope against a wall), a seed's
   acceleration is not the walls' error alone: settling moved the wall column of a lake on a
   3 % slope, and the balance of the columns behind it went from below 1 % of g s to 3.7 %;
@@ -47,7 +53,7 @@ their near list, out of open boundaries' zones, that are
   break's front, the seed's neighbours are pulled by the front, and settling would move the
   water toward it.
 
-The matching changes the seeded volume (+41 m3, 0.04 %, in the lake above); the model reports
+The matching changes the seeded volume (+40 m3, 0.04 %, in the lake above); the model reports
 the change (``FloodModel.volume_seed_adjustment``, ``volume_seed_adjustment_m3`` in
 ``run.json``) and the mass balance starts from the adjusted volume. Walls along the lattice
 (a box, a building aligned with it) leave every seed as it was.
@@ -84,11 +90,19 @@ LEVEL_TOLERANCE = 0.01
 neighbours, relative to its depth."""
 
 
-def clamp_shift(x, y, x0, y0, limit):
-    """Positions (x, y) [m] moved back toward (x0, y0) where they are further than ``limit``."""
-    sx, sy = x - x0, y - y0
-    f = np.minimum(1.0, limit / np.maximum(np.hypot(sx, sy), 1e-300))
-    return x0 + f * sx, y0 + f * sy
+def limited_move(ax, ay, dt, sx, sy, limit):
+    """Moves (mx, my) = f a dt^2 / 2 [m] of seeds with accelerations (ax, ay) [m s-2] and
+    pseudo-time steps dt [s], now (sx, sy) [m] from where they were seeded: f <= 1 is the
+    largest that keeps |s + m| <= ``limit`` [m], so a seed at the limit can still move along
+    it or back. A move that a wall reflects ends nearer the seed than it would have (the seed
+    lies on the wall's water side), so the bound holds after reflections too."""
+    mx, my = 0.5 * dt * dt * ax, 0.5 * dt * dt * ay
+    mm = mx * mx + my * my
+    sm = sx * mx + sy * my
+    room = np.maximum(limit * limit - sx * sx - sy * sy, 0.0)
+    f = (np.sqrt(sm * sm + mm * room) - sm) / np.maximum(mm, 1e-300)
+    f = np.minimum(1.0, f)
+    return f * mx, f * my
 
 
 def lattice_offsets(reach: float, dx: float) -> np.ndarray:
@@ -112,6 +126,20 @@ def open_nodes(owner, qx, qy, x, y, wstart, wseg, seg, visible):
             if crosses(x[i], y[i], qx[k], qy[k], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]):
                 visible[k] = False
                 break
+
+
+@njit(parallel=True, cache=True)
+def with_neighbours(rows, start, nbr, n, flag, out):
+    """out[k] = True if particle i = rows[k] and all its listed neighbours j < n are flagged
+    (gather over the rows)."""
+    for k in prange(rows.shape[0]):
+        i = rows[k]
+        ok = flag[i]
+        for q in range(start[i], start[i + 1]):
+            j = nbr[q]
+            if ok and j < n:
+                ok = flag[j]
+        out[k] = ok
 
 
 @njit(parallel=True, cache=True)

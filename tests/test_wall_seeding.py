@@ -35,7 +35,7 @@ def test_along_an_oblique_wall_the_seeds_read_the_seeded_depth(turned_lake):
 
 def test_the_adjustment_is_reported_and_small(turned_lake):
     """The seeds' volume changes by the reported ``volume_seed_adjustment`` only (measured
-    +41 m3 of 107,900 m3), and masses move by at most the bounds."""
+    +40 m3 of 107,900 m3), and masses move by at most the bounds."""
     model, seeded = turned_lake
     assert model.volume() == pytest.approx(seeded + model.volume_seed_adjustment, rel=1e-12)
     assert 0.0 < abs(model.volume_seed_adjustment) < 0.005 * seeded
@@ -43,16 +43,18 @@ def test_the_adjustment_is_reported_and_small(turned_lake):
     assert m.min() >= wall_seeding.MASS_MIN - 1e-12 and m.max() <= wall_seeding.MASS_MAX + 1e-12
 
 
-def test_still_water_along_an_oblique_wall_stays_nearly_still(turned_lake):
-    """After 100 s the 95th-percentile speed is below 1.5 cm/s (measured 0.9 cm/s; 3.7 cm/s
-    without the set-up, and 7.4 cm/s at 20 s) and the fastest particle below 5 cm/s
-    (measured 3.6; 4.6 without). The issue's 1 cm/s for every particle is not met."""
-    model, seeded = turned_lake
+def test_still_water_along_an_oblique_wall_stays_nearly_still():
+    """After 100 s the 95th-percentile speed is below 1.5 cm/s (measured 0.9 cm/s; 3.6 cm/s
+    without the set-up, and 7.3 cm/s at 20 s) and the fastest particle below 5 cm/s
+    (measured 3.6; 4.5 without); mass is exact. The issue's 1 cm/s for every particle is not
+    met."""
+    model, _ = STILL.build("turned-rectangle")
+    volume = model.volume()
     run_until(model, 100.0)
     speed = np.hypot(model.particles.u, model.particles.v)
     assert np.percentile(speed, 95) < 0.015
     assert speed.max() < 0.05
-    assert model.volume() == pytest.approx(seeded + model.volume_seed_adjustment, rel=1e-12)
+    assert model.volume() == pytest.approx(volume, rel=1e-12)
 
 
 def test_walls_along_the_lattice_change_nothing():
@@ -94,3 +96,22 @@ def test_seeds_whose_support_reaches_dry_ground_are_not_enclosed():
     inner = (y[near] + dx / 2 >= reach) & (100.0 + dx / 2 - y[near] >= reach)  # first dry nodes
     assert inner.any() and (~inner).any()
     np.testing.assert_array_equal(np.sort(enclosed), np.sort(near[inner]))
+
+
+def test_a_settling_move_stops_at_the_limit_but_not_short_of_it():
+    """Moves a dt^2 / 2 are shortened exactly to the limit from the seed, and only where they
+    would go beyond it; a seed at the limit can still move back."""
+    rng = np.random.default_rng(1)
+    n, limit = 10_000, 2.5
+    ax, ay = rng.normal(size=(2, n)) * 5.0
+    angle, r = rng.uniform(0.0, 2.0 * np.pi, n), rng.uniform(0.0, limit, n)
+    sx, sy = r * np.cos(angle), r * np.sin(angle)
+    mx, my = wall_seeding.limited_move(ax, ay, np.ones(n), sx, sy, limit)
+    end = np.hypot(sx + mx, sy + my)
+    free = np.hypot(sx + 0.5 * ax, sy + 0.5 * ay) <= limit
+    assert free.any() and (~free).any()
+    np.testing.assert_allclose(mx[free], 0.5 * ax[free], rtol=1e-12)
+    np.testing.assert_allclose(end[~free], limit, rtol=1e-12)
+    back = wall_seeding.limited_move(np.array([-1.0]), np.array([0.0]), np.ones(1),
+                                     np.array([limit]), np.array([0.0]), limit)
+    assert back[0][0] == -0.5
