@@ -214,7 +214,7 @@ def test_oblique_nodata_walls_hold_the_water():
 
 
 @pytest.mark.xfail(strict=True, reason="issue 2: along oblique walls still water does not stay "
-                   "still: measured p95 0.16 m/s, max 0.95 m/s at 20 s (0.23 and 1.4 m/s at "
+                   "still: measured p95 0.145 m/s, max 1.4 m/s at 20 s (0.20 and 1.3 m/s at "
                    "100 s), with the seeds at the walls settled. The fastest particles are "
                    "where the chords bend (one-cell jogs between chords, the lake's ends at "
                    "the grid border): there images switch on and off as particles pass")
