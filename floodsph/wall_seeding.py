@@ -44,10 +44,10 @@ their near list, out of open boundaries' zones, that are
 * still (:func:`still_water`, :func:`with_neighbours`): every particle within two
   neighbour lists of the seed (about 4.4 h) is at rest, and its neighbours' seeded depths and
   bed elevations differ from its own by at most ``LEVEL_TOLERANCE`` times its depth. Where
-  the water flows, or its
-  depth or the bed changes across the kernel (a lake on a slope against a wall), a seed's
-  acceleration is not the walls' error alone: settling moved the wall column of a lake on a
-  3 % slope, and the balance of the columns behind it went from below 1 % of g s to 3.7 %;
+  the water flows, or its depth or the bed changes across the kernel (a lake on a slope
+  against a wall), a seed's acceleration is not the walls' error alone: settling moved the
+  wall column of a lake on a 3 % slope, and the balance of the columns behind it went from
+  below 1 % of g s to 3.7 %;
 * enclosed (:func:`enclosed_seeds`): every lattice node within ``ENCLOSURE`` h of the seed is
   water (a seed within dx / 2 of it) or hidden behind a wall. Near a free shore or a dam
   break's front, the seed's neighbours are pulled by the front, and settling would move the
