@@ -393,9 +393,8 @@ class FloodModel:
         taken = 0
         while (taken < wall_seeding.SETTLE_STEPS
                and np.hypot(p.ax[idx], p.ay[idx]).max() >= wall_seeding.SETTLED * GRAVITY):
-            dt = np.full(idx.size, self.stable_dt())
-            mx[idx], my[idx] = wall_seeding.limited_move(p.ax[idx], p.ay[idx], dt, p.x[idx] - x0,
-                                                         p.y[idx] - y0, limit)
+            mx[idx], my[idx] = wall_seeding.limited_move(p.ax[idx], p.ay[idx], self.stable_dt(),
+                                                         p.x[idx] - x0, p.y[idx] - y0, limit)
             wallmod.drift(p.x, p.y, mx, my, 1.0, *self.walls_near[:2], self.seg)
             self._interactions(settle=True)
             taken += 1

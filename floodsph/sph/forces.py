@@ -212,8 +212,8 @@ SUMS = 9  # columns of the sums: D (x, y), E (x, y), g M (xx, xy, yy), e (x, y)
 
 @njit(inline="always", cache=True)
 def _subtract(acc, i, j, rho, t):
-    """Subtract the terms t = (rx, ry, fx, fy, w, fd) of :func:`pair_force` for the pair of i
-    and j (or j's image) from i's sums ``acc``, a tuple, with d = rho / rho_w:
+    """Subtract the terms t = (rx, ry, fx, fy, w, fd, af) of :func:`pair_force` for the pair
+    of i and j (or j's image) from i's sums ``acc``, a tuple, with d = rho / rho_w:
 
     0-1: a^int = - sum (fx, fy) [m s-2];
     2-3: D = - sum w (d_j - d_i) r [m s-2], the hydrostatic pressure force's difference part;
