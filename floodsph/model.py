@@ -350,9 +350,12 @@ class FloodModel:
         self.counters["seeds_settled"] = int(idx.size)
         if idx.size == 0:
             return 0.0
-        self._settle(idx)
+        rows = wall_seeding.neighbourhood(idx, self.nl.start, self.nl.nbr, self.particles.n,
+                                          wall_seeding.RINGS)
+        self._settle(idx, rows)
         v0 = self.particles.volume()
-        self._match_masses(idx, rho_seed[idx])
+        self._match_masses(idx, rho_seed[idx], rows)
+        self._interactions(settle=True)
         return self.particles.volume() - v0
 
     def _wall_seeds(self, rho_seed: np.ndarray) -> np.ndarray:
@@ -381,11 +384,12 @@ class FloodModel:
         return wall_seeding.enclosed_seeds(p.x, p.y, wall_seeding.ENCLOSURE * p.h, rows,
                                            dx, wstart, wseg, self.seg)
 
-    def _settle(self, idx: np.ndarray) -> None:
+    def _settle(self, idx: np.ndarray, rows: np.ndarray) -> None:
         """Move the particles ``idx`` by a dt^2 / 2 per round, along their acceleration (walls
         reflecting), with dt the model's CFL step, each at most ``wall_seeding.MAX_SHIFT``
         spacings in all from its seed, the others held, until |a| < ``wall_seeding.SETTLED`` g
-        or for ``wall_seeding.SETTLE_STEPS`` rounds."""
+        or for ``wall_seeding.SETTLE_STEPS`` rounds. Each round solves density and forces
+        for ``rows`` alone: ``idx`` and every particle whose density they may change."""
         p = self.particles
         x0, y0 = p.x[idx].copy(), p.y[idx].copy()
         mx, my = np.zeros(p.n), np.zeros(p.n)
@@ -396,13 +400,14 @@ class FloodModel:
             mx[idx], my[idx] = wall_seeding.limited_move(p.ax[idx], p.ay[idx], self.stable_dt(),
                                                          p.x[idx] - x0, p.y[idx] - y0, limit)
             wallmod.drift(p.x, p.y, mx, my, 1.0, *self.walls_near[:2], self.seg)
-            self._interactions(settle=True)
+            self._interactions(settle=True, rows=rows)
             taken += 1
         self.counters["settle_steps"] = taken
 
-    def _match_masses(self, idx: np.ndarray, rho_target: np.ndarray) -> None:
+    def _match_masses(self, idx: np.ndarray, rho_target: np.ndarray, rows: np.ndarray) -> None:
         """Jacobi iteration m_i <- m_i rho_target_i / rho_i on the particles ``idx``, each
-        mass kept within [``MASS_MIN``, ``MASS_MAX``] times its start (``wall_seeding``)."""
+        mass kept within [``MASS_MIN``, ``MASS_MAX``] times its start (``wall_seeding``);
+        density and forces solved for ``rows`` alone (:meth:`_settle`)."""
         p = self.particles
         m0 = p.m[idx].copy()
         for _ in range(wall_seeding.ROUNDS):
@@ -411,7 +416,7 @@ class FloodModel:
                 break
             p.m[idx] = np.clip(p.m[idx] * ratio, wall_seeding.MASS_MIN * m0,
                                wall_seeding.MASS_MAX * m0)
-            self._interactions(settle=True)
+            self._interactions(settle=True, rows=rows)
 
     def _remove_outside(self, nodata: bool) -> None:
         """Remove (and count as outflow) particles off the grid, and in nodata cells if
@@ -478,7 +483,8 @@ class FloodModel:
         catches up over the next steps; if the lists are older, they are rebuilt and the solve
         repeated once. When the model is set up (``settle``), h may move far from the seeding
         guess, so the lists are rebuilt and the solve repeated until they hold (at most
-        ``SETTLE_ROUNDS``).
+        ``SETTLE_ROUNDS``); lists of some rows alone (the set-up's settling of wall seeds)
+        hold while they cover those rows, as the other particles do not change then.
         """
         num = self.numerics
         p = self.particles
@@ -489,7 +495,7 @@ class FloodModel:
                 p, self.nl, self.blocked, self.wdist, self.walls_near, self.seg,
                 tol=num.density_tol, max_iter=num.density_max_iter, h_ratio=num.h_ratio,
                 cap=not settle)
-            if settle and self.nl.still_valid(p.x, p.y, p.h):
+            if settle and self.nl.covers(p.x, p.y, p.h):
                 break
             if not settle and (capped == 0 or self._nl_fresh):
                 break

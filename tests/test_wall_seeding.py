@@ -115,3 +115,30 @@ def test_a_settling_move_stops_at_the_limit_but_not_short_of_it():
     back = wall_seeding.limited_move(np.array([-1.0]), np.array([0.0]), np.ones(1),
                                      np.array([limit]), np.array([0.0]), limit)
     assert back[0][0] == -0.5
+
+
+def test_settling_the_seeds_neighbourhood_alone_moves_them_as_settling_everything(
+        turned_lake, monkeypatch):
+    """Each settling round solves density and forces for the seeds and two rings of their
+    neighbours only (``wall_seeding.neighbourhood``): the particles farther off cannot change.
+    The seeds then end where rounds over every particle put them, with the same masses."""
+    model, _ = turned_lake
+    monkeypatch.setattr(wall_seeding, "neighbourhood",
+                        lambda rows, start, nbr, n, rings: np.arange(n, dtype=np.int64))
+    everything, _ = STILL.build("turned-rectangle")
+    assert model.counters["seeds_settled"] == everything.counters["seeds_settled"] > 400
+    p, q = model.particles, everything.particles
+    np.testing.assert_allclose(p.x, q.x, rtol=0.0, atol=1e-9)
+    np.testing.assert_allclose(p.y, q.y, rtol=0.0, atol=1e-9)
+    np.testing.assert_allclose(p.m, q.m, rtol=1e-12)
+
+
+def test_a_neighbourhood_holds_the_rows_and_what_their_lists_hold_ring_by_ring():
+    start = np.array([0, 2, 3, 5, 6, 6])
+    nbr = np.array([1, 7, 0, 3, 4, 2])  # 7 >= n: a ghost, left out
+    assert wall_seeding.neighbourhood(np.array([0]), start, nbr, 5, 1).tolist() == [0, 1]
+    assert wall_seeding.neighbourhood(np.array([2]), start, nbr, 5, 1).tolist() == [2, 3, 4]
+    assert wall_seeding.neighbourhood(np.array([2]), start, nbr, 5, 2).tolist() == [2, 3, 4]
+    rows = np.array([3, 0])
+    assert wall_seeding.neighbourhood(rows, start, nbr, 5, 1).tolist() == [0, 1, 2, 3]
+    assert wall_seeding.neighbourhood(rows, start, nbr, 5, 2).tolist() == [0, 1, 2, 3, 4]

@@ -377,13 +377,18 @@ class NeighbourList:
         self.nbr = _lists(args, self.rows, self.start)
 
     def still_valid(self, x, y, h) -> bool:
-        """True while the list still holds every pair with r_ij < 2 max(h_i, h_j).
+        """True while the list still holds every pair with r_ij < 2 max(h_i, h_j), and lists
+        every particle's neighbours (:meth:`covers`, with every row listed)."""
+        return self.complete and self.covers(x, y, h)
+
+    def covers(self, x, y, h) -> bool:
+        """True while the listed rows still hold every pair with r_ij < 2 max(h_i, h_j).
 
         With G = max h_i / h_b,i and D = max |x_i - x_b,i| / h_b,i (b: at the build), a pair
         within the support now was within 2 (G + D) max(h_b,i, h_b,j) at the build, so the
-        list is exact while G + D <= 1 + skin (same particle count, and every row listed).
+        list is exact while G + D <= 1 + skin (and the particle count is the same).
         """
-        if not self.complete or x.shape[0] != self.x_built.shape[0]:
+        if x.shape[0] != self.x_built.shape[0]:
             return False
         if x.shape[0] == 0:
             return True
