@@ -352,10 +352,11 @@ class FloodModel:
             return 0.0
         rows = wall_seeding.neighbourhood(idx, self.nl.start, self.nl.nbr, self.particles.n,
                                           wall_seeding.RINGS)
-        self._settle(idx, rows)
+        rounds = self._settle(idx, rows)
         v0 = self.particles.volume()
-        self._match_masses(idx, rho_seed[idx], rows)
-        self._interactions(settle=True)
+        rounds += self._match_masses(idx, rho_seed[idx], rows)
+        if rounds:  # lists and sums of every particle again, for the first step
+            self._interactions(settle=True)
         return self.particles.volume() - v0
 
     def _wall_seeds(self, rho_seed: np.ndarray) -> np.ndarray:
@@ -384,12 +385,13 @@ class FloodModel:
         return wall_seeding.enclosed_seeds(p.x, p.y, wall_seeding.ENCLOSURE * p.h, rows,
                                            dx, wstart, wseg, self.seg)
 
-    def _settle(self, idx: np.ndarray, rows: np.ndarray) -> None:
+    def _settle(self, idx: np.ndarray, rows: np.ndarray) -> int:
         """Move the particles ``idx`` by a dt^2 / 2 per round, along their acceleration (walls
         reflecting), with dt the model's CFL step, each at most ``wall_seeding.MAX_SHIFT``
         spacings in all from its seed, the others held, until |a| < ``wall_seeding.SETTLED`` g
         or for ``wall_seeding.SETTLE_STEPS`` rounds. Each round solves density and forces
-        for ``rows`` alone: ``idx`` and every particle whose density they may change."""
+        for ``rows`` alone: ``idx`` and every particle whose density they may change. Returns
+        the number of rounds."""
         p = self.particles
         x0, y0 = p.x[idx].copy(), p.y[idx].copy()
         mx, my = np.zeros(p.n), np.zeros(p.n)
@@ -403,20 +405,25 @@ class FloodModel:
             self._interactions(settle=True, rows=rows)
             taken += 1
         self.counters["settle_steps"] = taken
+        return taken
 
-    def _match_masses(self, idx: np.ndarray, rho_target: np.ndarray, rows: np.ndarray) -> None:
+    def _match_masses(self, idx: np.ndarray, rho_target: np.ndarray, rows: np.ndarray) -> int:
         """Jacobi iteration m_i <- m_i rho_target_i / rho_i on the particles ``idx``, each
         mass kept within [``MASS_MIN``, ``MASS_MAX``] times its start (``wall_seeding``);
-        density and forces solved for ``rows`` alone (:meth:`_settle`)."""
+        density and forces solved for ``rows`` alone (:meth:`_settle`). Returns the number of
+        solves."""
         p = self.particles
         m0 = p.m[idx].copy()
-        for _ in range(wall_seeding.ROUNDS):
+        solves = 0
+        while solves < wall_seeding.ROUNDS:
             ratio = rho_target / p.rho[idx]
             if np.abs(ratio - 1.0).max() < wall_seeding.TOLERANCE:
                 break
             p.m[idx] = np.clip(p.m[idx] * ratio, wall_seeding.MASS_MIN * m0,
                                wall_seeding.MASS_MAX * m0)
             self._interactions(settle=True, rows=rows)
+            solves += 1
+        return solves
 
     def _remove_outside(self, nodata: bool) -> None:
         """Remove (and count as outflow) particles off the grid, and in nodata cells if
