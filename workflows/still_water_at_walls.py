@@ -14,7 +14,8 @@ Cases (flat, frictionless beds; walls as ``FloodModel(walls=...)`` polylines):
 
 For each case and set-up it prints the largest depth error at t = 0, the seeds the set-up
 selects (moved only when it is on), its volume change, its time in seconds and in time steps
-(the set-up's time over the mean time of the run's first ten steps, measured in the same run),
+(the set-up's time over the mean time of the run's first ten steps, measured in the same run;
+the first case's set-up includes numba's compilation),
 and the 95th-percentile and largest speed after each of ``--times`` (for Ritter, the L1 depth
 error and the front's error at 50 s instead). "off" sets
 ``wall_seeding.SETTLE_STEPS`` and ``wall_seeding.ROUNDS`` to 0.
