@@ -67,7 +67,7 @@ HEXAGON_MARGIN = 1.01
 """Radius, relative to a parent's hexagon, within which wall segments are tested against the
 lines to its daughters (a segment across such a line is closer than the radius itself)."""
 RELAX_RATE = 0.2
-"""Fraction of the excess ln(h^2 rho / (SMOOTHING_EXCESS kappa^2 m)) removed per step."""
+"""Fraction of the excess ln(h^2 rho / (smoothing_excess kappa^2 m)) removed per step."""
 EDGE_ALPHA = 0.8
 """Particles with alpha_i < EDGE_ALPHA 2 rho_i (a kernel support short of neighbours: a wet/dry
 edge) are not relaxed (:func:`relax_smoothing`)."""
@@ -78,10 +78,11 @@ an area_min particle's, and such a particle, a shallow seed or a daughter carrie
 fast water, sets the global time step (on Malpasset at 20 m the step-setting particles had h
 of 4-5 m among neighbours of 26 m)."""
 SMOOTHING_EXCESS = 3.0
-"""Split particles relax to h = sqrt(3) kappa sqrt(m / rho), not to the lattice value: on the
-coarse Ritter case (tests/test_refine.py) and the first 60 s of Malpasset this beat both no
-relaxation (L1 2.3 %, front 252 m behind; 128 s of wall time) and relaxation to the lattice
-value (L1 3.7 %; 77 s): L1 1.8 %, front 19 m, 50 s."""
+"""Default of ``Refinement.smoothing_excess``: split particles relax to h = sqrt(3) kappa
+sqrt(m / rho), not to the lattice value: on the coarse Ritter case (tests/test_refine.py) and
+the first 60 s of Malpasset this beat both no relaxation (L1 2.3 %, front 252 m behind; 128 s
+of wall time) and relaxation to the lattice value (L1 3.7 %; 77 s): L1 1.8 %, front 19 m,
+50 s. The Ritter convergence study is sensitive to it (``workflows/ritter_sensitivity.py``)."""
 
 
 @dataclass(frozen=True)
@@ -97,6 +98,8 @@ class Refinement:
     merge_interval : look for merges every this many steps.
     depth_jump : no merge when |d_a - d_b| > depth_jump max(d_a, d_b).
     speed_jump : no merge when |v_a - v_b| > speed_jump sqrt(g max(d_a, d_b)).
+    smoothing_excess : split particles relax to h^2 rho = smoothing_excess kappa^2 m
+        (:func:`relax_smoothing`; 1 is the lattice value).
     """
 
     mode: str = "split+coalesce"
@@ -108,6 +111,7 @@ class Refinement:
     merge_interval: int = 5
     depth_jump: float = 0.5
     speed_jump: float = 0.5
+    smoothing_excess: float = SMOOTHING_EXCESS
 
     def __post_init__(self):
         if self.mode not in MODES:
@@ -118,6 +122,9 @@ class Refinement:
                 f"split again at once; got area_min={self.area_min}, area_max={self.area_max}")
         if self.d_min < 0.0 or self.max_level < 0 or self.no_merge_steps < 0:
             raise InputError("refinement: d_min, max_level and no_merge_steps must be >= 0")
+        if not self.smoothing_excess >= 1.0:
+            raise InputError(f"refinement: smoothing_excess must be >= 1 (the lattice value), "
+                             f"got {self.smoothing_excess}")
         if self.merge_interval < 1:
             raise InputError(f"refinement: merge_interval must be >= 1, got "
                              f"{self.merge_interval}")
@@ -175,7 +182,7 @@ class Refiner:
         if not s.splits or model.particles.n == 0:
             return 0, 0
         rate = RELAX_RATE if steps == 1 else 1.0 - (1.0 - RELAX_RATE) ** steps
-        relax_smoothing(model.particles, model.numerics.kappa, rate)
+        relax_smoothing(model.particles, model.numerics.kappa, rate, s.smoothing_excess)
         parents = self.split_candidates(model)
         a = b = np.zeros(0, dtype=np.int64)
         if s.coalesces and merge_due:
@@ -237,14 +244,14 @@ class Refiner:
             ok &= clear
         return idx[ok]
 
-    @staticmethod
-    def _daughter_positions(p, idx, kappa):
+    def _daughter_positions(self, p, idx, kappa):
         from floodsph.sph import refine
 
         n = refine.DAUGHTERS * idx.size
         x, y, m = np.empty(n), np.empty(n), np.empty(n)
         refine.daughters(p.x[idx], p.y[idx], p.u[idx], p.v[idx], p.m[idx],
-                         _parent_h(p, idx, kappa), refine.EPS, refine.STILL_SPEED, x, y, m)
+                         _parent_h(p, idx, kappa, self.settings.smoothing_excess), refine.EPS,
+                         refine.STILL_SPEED, x, y, m)
         return x, y, m
 
     def _split(self, model, idx) -> dict | None:
@@ -256,8 +263,9 @@ class Refiner:
         p = model.particles
         x, y, m = self._daughter_positions(p, idx, model.numerics.kappa)
         rep = np.repeat(idx, refine.DAUGHTERS)
-        h = refine.H_FACTOR * np.repeat(_parent_h(p, idx, model.numerics.kappa),
-                                        refine.DAUGHTERS)
+        h = refine.H_FACTOR * np.repeat(
+            _parent_h(p, idx, model.numerics.kappa, self.settings.smoothing_excess),
+            refine.DAUGHTERS)
         rho = p.rho[rep]
         return dict(x=x, y=y, u=p.u[rep], v=p.v[rep], m=m, rho=rho, h=h, h0=h, rho0=rho,
                     alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, model.steps),
@@ -379,13 +387,14 @@ class Refiner:
                     stride=np.minimum(p.stride[a], p.stride[b]))
 
 
-def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE) -> None:
-    """Relax over-smoothed particles toward h^2 rho = SMOOTHING_EXCESS kappa^2 m.
+def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE,
+                    excess: float = SMOOTHING_EXCESS) -> None:
+    """Relax over-smoothed particles toward h^2 rho = excess kappa^2 m.
 
     The density solve keeps C_i = h0_i^2 rho0_i = h_i^2 rho_i fixed. A daughter starts with
     C = (0.9 h_p)^2 rho_p, about 5.7 times kappa^2 m_k, and a second split compounds it, so
     its neighbour count and smoothing grow with every generation (method notes 4.3, caveat).
-    Each step, ln C moves by ``rate`` of the way to ln(SMOOTHING_EXCESS kappa^2 m) where C
+    Each step, ln C moves by ``rate`` of the way to ln(excess kappa^2 m) where C
     exceeds it; h0 and the current h (the Newton guess) are rescaled alike, so the density
     solve follows in a few iterations and the excess is gone about 10 steps after a split.
 
@@ -398,7 +407,7 @@ def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE) -> None:
     front of a refined dam break ran at up to 28 m/s, 40 % above the bound 2 sqrt(g d0) of the
     exact solution (``tests/test_refine.py``).
     """
-    target = SMOOTHING_EXCESS * kappa * kappa * p.m
+    target = excess * kappa * kappa * p.m
     c = p.h0 * p.h0 * p.rho0
     over = np.flatnonzero((c > target * (1.0 + 1e-9)) & (p.alpha >= EDGE_ALPHA * 2.0 * p.rho))
     if over.size:
@@ -407,9 +416,10 @@ def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE) -> None:
         p.h[over] *= f
 
 
-def _parent_h(p, idx, kappa: float) -> np.ndarray:
+def _parent_h(p, idx, kappa: float, excess: float) -> np.ndarray:
     """Smoothing lengths [m] the parents ``idx`` pass on to their daughters: h_p, but at most
-    the relaxed value sqrt(SMOOTHING_EXCESS) kappa sqrt(m_p / rho_p).
+    the relaxed value sqrt(excess) kappa sqrt(m_p / rho_p) (``excess``: see
+    :func:`relax_smoothing`).
 
     A parent at a wet/dry edge is not relaxed (:func:`relax_smoothing`) and may still carry a
     daughter's inflated h. Passing that on would compound it generation by generation: the
@@ -417,7 +427,7 @@ def _parent_h(p, idx, kappa: float) -> np.ndarray:
     (in the refined 5 m Ritter run, the largest excess seen is 10.2 without this bound and
     5.9 with it).
     """
-    return np.minimum(p.h[idx], math.sqrt(SMOOTHING_EXCESS) * kappa
+    return np.minimum(p.h[idx], math.sqrt(excess) * kappa
                       * np.sqrt(p.m[idx] / p.rho[idx]))
 
 

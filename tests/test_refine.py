@@ -444,6 +444,37 @@ def test_a_parent_passes_on_at_most_its_relaxed_smoothing():
                                rtol=1e-12)
 
 
+def test_the_refiner_relaxes_and_bounds_smoothing_to_its_own_smoothing_excess():
+    """Refinement.smoothing_excess (here 2, default 3) sets both the h a parent passes on,
+    0.9 min(h_p, sqrt(2) kappa sqrt(m_p / rho_p)), and the daughters' relaxed h^2 rho."""
+    model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
+    p = model.particles
+    kappa = model.numerics.kappa
+    centre = np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 1.0)
+    p.h[centre] *= 3.0
+    bound = math.sqrt(2.0) * kappa * np.sqrt(p.m[centre] / p.rho[centre])
+    n0 = p.n - centre.size
+    refiner = Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05,
+                                 smoothing_excess=2.0), 1.0)
+    refiner.execute(model, centre, [], [])
+    np.testing.assert_allclose(p.h[n0:].reshape(-1, refine.DAUGHTERS),
+                               np.repeat(refine.H_FACTOR * bound[:, None], refine.DAUGHTERS,
+                                         axis=1), rtol=1e-12)
+    daughters = p.level > 0
+    relaxer = Refiner(Refinement(mode="split", area_max=1e9, area_min=0.05,
+                                 smoothing_excess=2.0), 1.0)  # no further splits
+    for step in range(1, 61):
+        model.steps = step  # Refiner.apply relaxes once per model step
+        assert relaxer.apply(model) == (0, 0)
+    c = p.h0**2 * p.rho0 / (kappa**2 * p.m)
+    np.testing.assert_allclose(c[daughters], 2.0, rtol=1e-5)
+
+
+def test_a_smoothing_excess_below_the_lattice_value_is_refused():
+    with pytest.raises(InputError, match="smoothing_excess"):
+        Refinement(smoothing_excess=0.9)
+
+
 def test_a_small_particle_beside_a_large_one_still_finds_its_merge_partner():
     x = np.array([0.0, 1.0, 0.3])  # 0's nearest neighbour is 2, a large non-candidate
     y = np.zeros(3)
