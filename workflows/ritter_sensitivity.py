@@ -13,9 +13,11 @@ Prints a Markdown table and writes it, with the command, to ``--out`` (default
 ``results/ritter_sensitivity.md``). The runs are deterministic; the spread between
 neighbouring values shows how close the targets lie to the scheme's split-and-merge noise.
 
-First it prints the density dipole one split leaves (:func:`split_column_dipole`): a column of
-particles split in a lake at rest, the daughters' depth and that of the unsplit particles
-beside them.
+First it prints two static density dipoles in a lake at rest: the one a split leaves
+(:func:`split_column_dipole`: a column of particles split, the daughters' depth and that of the
+unsplit particles beside them), and the one at a resolution interface with no split at all
+(:func:`resolution_interface_dipole`: a flow-stretched lattice beside the lattice of its
+daughters, the depth of the last coarse and the first fine column).
 
     python workflows/ritter_sensitivity.py [--excess 2 2.5 3 4] [--mode split+coalesce]
         [--spacings 10 5 2.5] [--out results/ritter_sensitivity.md]
@@ -64,6 +66,41 @@ def split_column_dipole(d0: float = 4.0, dx: float = 10.0) -> dict:
             "beside": (d[beside].min(), d[beside].max())}
 
 
+def resolution_interface_dipole(d0: float = 5.0, dx: float = 5.0) -> dict:
+    """Depths [m] across a resolution interface in a lake at rest, with no split at all.
+
+    Flat, 400 m x 100 m, depth d0: for x < 200 m the lattice a thinning channel flow leaves
+    just before its particles split (2 dx along the flow, dx across, mass rho_w d0 2 dx^2,
+    h = kappa sqrt(2) dx); beyond, the lattice of its daughters (dx by dx, half the mass,
+    h = kappa dx). Returns the mean depths, over the middle rows, of the coarse lattice
+    (x 100-160 m), its last column and the first fine column. Any split pattern leaves such an
+    interface: the coarse kernel spans under two spacings each way along the flow
+    (2 h / (2 dx) = kappa / sqrt(2)), and the fine particles beside it weigh more in its sum
+    than the coarse column they replace.
+    """
+    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, 400), (0, 100), dx)
+    xc, yc = np.meshgrid(np.arange(dx, 200, 2 * dx), np.arange(dx / 2, 100, dx))
+    xf, yf = np.meshgrid(np.arange(200 + dx / 2, 400, dx), np.arange(dx / 2, 100, dx))
+    nc, nf = xc.size, xf.size
+    kappa = Numerics.kappa
+    p = ParticleSet(nc + nf)
+    p.append(x=np.r_[xc.ravel(), xf.ravel()], y=np.r_[yc.ravel(), yf.ravel()],
+             m=RHO_WATER * d0 * dx * dx * np.r_[np.full(nc, 2.0), np.full(nf, 1.0)],
+             rho=np.full(nc + nf, RHO_WATER * d0),
+             h=kappa * dx * np.r_[np.full(nc, np.sqrt(2.0)), np.full(nf, 1.0)])
+    model = FloodModel(terrain, p, Numerics(spacing=dx))
+    model.step(1e-9)  # neighbour lists and the density solve, the particles all but unmoved
+    d = p.rho / RHO_WATER
+    middle = np.abs(p.y - 50.0) < 15.0
+
+    def mean_depth(a, b):
+        return float(d[middle & (p.x > a) & (p.x < b)].mean())
+
+    return {"depth": d0, "coarse": mean_depth(100.0, 160.0),
+            "last coarse": mean_depth(200.0 - 2 * dx, 200.0),
+            "first fine": mean_depth(200.0, 200.0 + dx)}
+
+
 def study(excess: float, mode: str, spacings: list[float]) -> dict:
     """One convergence study: the row of the table for ``smoothing_excess = excess``."""
     results = [cases.ritter(dx, refinement=Refinement(mode=mode, smoothing_excess=excess))
@@ -93,10 +130,16 @@ def main(argv=None) -> int:
     ap.add_argument("--spacings", type=float, nargs="+", default=[10.0, 5.0, 2.5])
     ap.add_argument("--out", type=Path, default=Path("results/ritter_sensitivity.md"))
     args = ap.parse_args(argv)
+    if len(set(args.spacings)) < 2:
+        ap.error(f"--spacings: an observed order needs two spacings or more, got {args.spacings}")
     dipole = split_column_dipole()
     dipole_line = ("one split column in a lake at rest, depth {depth} m: daughters "
                    "{0:.3f}-{1:.3f} m, unsplit particles beside them {2:.3f}-{3:.3f} m").format(
         *dipole["daughters"], *dipole["beside"], depth=dipole["depth"])
+    interface = resolution_interface_dipole()
+    dipole_line += ("; a stretched lattice beside its daughters' lattice, depth {depth} m: "
+                    "last coarse column {0:.3f} m, first fine column {1:.3f} m").format(
+        interface["last coarse"], interface["first fine"], depth=interface["depth"])
     print(dipole_line, flush=True)
     rows = []
     for excess in args.excess:
