@@ -125,6 +125,8 @@ def arr_class(d, v, arr_limits):
 @njit(parallel=True, cache=True)
 def _classify(d, v, wet_threshold, uk_upper, debris_upper, debris_df, debris_speed,
               arr_limits, out_uk, out_arr):
+    """UK and Australian classes of each (d [m], v [m/s]) into out_uk and out_arr (0 where
+    d <= wet_threshold [m]), with :func:`uk_class` and :func:`arr_class` (module docstring)."""
     for i in prange(d.shape[0]):
         if d[i] > wet_threshold:
             out_uk[i] = uk_class(d[i], v[i], uk_upper, debris_upper, debris_df, debris_speed)

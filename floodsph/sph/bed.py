@@ -19,6 +19,10 @@ from numba import njit, prange
 
 @njit(inline="always", cache=True)
 def _weights(x, y, dx, dy, nx, ny):
+    """Lower-left node (i0, j0) and fractions (tx, ty) in [0, 1] of the bilinear stencil
+    around (x, y) [m] on an (ny, nx) node-centred grid of spacing (dx, dy) [m]:
+    fx = x / dx - 1/2, j0 = floor(fx), tx = fx - j0 (likewise in y), clamped to the border
+    (module docstring)."""
     fx = x / dx - 0.5
     fy = y / dy - 0.5
     j0 = min(max(int(math.floor(fx)), 0), nx - 2)
@@ -30,6 +34,8 @@ def _weights(x, y, dx, dy, nx, ny):
 
 @njit(inline="always", cache=True)
 def _lerp(g, i0, j0, tx, ty):
+    """Bilinear interpolation of grid g (units of g) with the stencil of :func:`_weights`:
+    (1 - ty) [(1 - tx) g00 + tx g01] + ty [(1 - tx) g10 + tx g11]."""
     return (
         (1.0 - ty) * ((1.0 - tx) * g[i0, j0] + tx * g[i0, j0 + 1])
         + ty * ((1.0 - tx) * g[i0 + 1, j0] + tx * g[i0 + 1, j0 + 1])

@@ -54,6 +54,9 @@ def _pair(rx, ry, mj, hi):
 
 @njit(inline="always", cache=True)
 def _image(i, j, x, y, m, hi, seg, s):
+    """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's mirror image across segment s
+    (x_j' = 2 f_j - x_j, ``floodsph.sph.walls.wall_image``) seen from i; (0, 0) when the wall
+    does not hide that image's point from i (MVBP mirror particles, method notes 3.1)."""
     xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
     if not ok:
         return 0.0, 0.0
@@ -62,6 +65,9 @@ def _image(i, j, x, y, m, hi, seg, s):
 
 @njit(inline="always", cache=True)
 def _corner(i, j, x, y, m, hi, seg, s1, s2):
+    """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's point reflection through the
+    right-angled corner of segments s1 and s2 (``floodsph.sph.walls.corner_image``) seen from
+    i; (0, 0) when that image does not apply (method notes 3.1)."""
     xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
     if not ok:
         return 0.0, 0.0

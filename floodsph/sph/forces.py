@@ -261,6 +261,10 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
 
 @njit(inline="always", cache=True)
 def _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme):
+    """:func:`pair_force` terms [m s-2] of i with j's mirror image across segment s: position
+    x_j' = 2 f_j - x_j, free-slip velocity v_j' = v_j - 2 (v_j . n) n, and j's renormalisation
+    tensor reflected, R K_j R with R = I - 2 n n^T; zeros when the wall does not hide the
+    image's point from i (MVBP mirror particles, method notes 3.1)."""
     xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
     if not ok:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -275,6 +279,10 @@ def _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme):
 
 @njit(inline="always", cache=True)
 def _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s1, s2, scheme):
+    """:func:`pair_force` terms [m s-2] of i with j's point reflection through the right-angled
+    corner of segments s1 and s2: the velocity and K_j reflected about both walls' normals in
+    turn (v' = R2 R1 v_j, K' = R2 R1 K_j R1 R2); zeros when that image does not apply
+    (method notes 3.1)."""
     xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
     if not ok:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
