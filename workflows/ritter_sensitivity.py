@@ -138,8 +138,9 @@ def main(argv=None) -> int:
         *dipole["daughters"], *dipole["beside"], depth=dipole["depth"])
     interface = resolution_interface_dipole()
     dipole_line += ("; a stretched lattice beside its daughters' lattice, depth {depth} m: "
-                    "last coarse column {0:.3f} m, first fine column {1:.3f} m").format(
-        interface["last coarse"], interface["first fine"], depth=interface["depth"])
+                    "stretched lattice {0:.3f} m, its last column {1:.3f} m, first fine column "
+                    "{2:.3f} m").format(interface["coarse"], interface["last coarse"],
+                                        interface["first fine"], depth=interface["depth"])
     print(dipole_line, flush=True)
     rows = []
     for excess in args.excess:
