@@ -34,6 +34,7 @@ import numpy as np
 from floodsph import testing as exact
 from floodsph import verification as cases
 from floodsph.constants import RHO_WATER
+from floodsph.errors import InputError
 from floodsph.model import FloodModel, Numerics
 from floodsph.output.tables import markdown
 from floodsph.particles import ParticleSet
@@ -45,15 +46,22 @@ ORDER_MIN = 0.8
 FRONT_SPACINGS = 2.0
 
 
+def _still_lake(size, dx, d0, x, y, area, h) -> FloodModel:
+    """Still water d0 [m] deep on a flat bed of ``size`` (width, height) [m]: particles at
+    (x, y) [m] with areas ``area`` [m2] (mass rho_w d0 area) and smoothing lengths h [m]."""
+    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, size[0]), (0, size[1]), dx)
+    p = ParticleSet(x.size)
+    p.append(x=x, y=y, m=RHO_WATER * d0 * area, rho=np.full(x.size, RHO_WATER * d0), h=h)
+    return FloodModel(terrain, p, Numerics(spacing=dx))
+
+
 def split_column_dipole(d0: float = 4.0, dx: float = 10.0) -> dict:
     """Depths [m] after splitting one column of a lake at rest (depth d0, spacing dx, 400 m x
     200 m, flat): the daughters' range and the range of the unsplit particles within 3 dx."""
-    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, 400), (0, 200), dx)
     X, Y = np.meshgrid(np.arange(dx / 2, 400, dx), np.arange(dx / 2, 200, dx))
-    p = ParticleSet(X.size)
-    p.append(x=X.ravel(), y=Y.ravel(), m=np.full(X.size, RHO_WATER * d0 * dx * dx),
-             rho=np.full(X.size, RHO_WATER * d0), h=np.full(X.size, Numerics.kappa * dx))
-    model = FloodModel(terrain, p, Numerics(spacing=dx))
+    model = _still_lake((400, 200), dx, d0, X.ravel(), Y.ravel(), np.full(X.size, dx * dx),
+                        np.full(X.size, Numerics.kappa * dx))
+    p = model.particles
     column = np.flatnonzero((np.abs(p.x - 205.0) < 1.0) & (p.y > 40.0) & (p.y < 160.0))
     Refiner(Refinement(mode="split", area_max=0.5, area_min=0.2), dx).execute(
         model, column, [], [])
@@ -78,17 +86,14 @@ def resolution_interface_dipole(d0: float = 5.0, dx: float = 5.0) -> dict:
     (2 h / (2 dx) = kappa / sqrt(2)), and the fine particles beside it weigh more in its sum
     than the coarse column they replace.
     """
-    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, 400), (0, 100), dx)
     xc, yc = np.meshgrid(np.arange(dx, 200, 2 * dx), np.arange(dx / 2, 100, dx))
     xf, yf = np.meshgrid(np.arange(200 + dx / 2, 400, dx), np.arange(dx / 2, 100, dx))
     nc, nf = xc.size, xf.size
-    kappa = Numerics.kappa
-    p = ParticleSet(nc + nf)
-    p.append(x=np.r_[xc.ravel(), xf.ravel()], y=np.r_[yc.ravel(), yf.ravel()],
-             m=RHO_WATER * d0 * dx * dx * np.r_[np.full(nc, 2.0), np.full(nf, 1.0)],
-             rho=np.full(nc + nf, RHO_WATER * d0),
-             h=kappa * dx * np.r_[np.full(nc, np.sqrt(2.0)), np.full(nf, 1.0)])
-    model = FloodModel(terrain, p, Numerics(spacing=dx))
+    model = _still_lake((400, 100), dx, d0, np.r_[xc.ravel(), xf.ravel()],
+                        np.r_[yc.ravel(), yf.ravel()],
+                        dx * dx * np.r_[np.full(nc, 2.0), np.full(nf, 1.0)],
+                        Numerics.kappa * dx * np.r_[np.full(nc, np.sqrt(2.0)), np.full(nf, 1.0)])
+    p = model.particles
     model.step(1e-9)  # neighbour lists and the density solve, the particles all but unmoved
     d = p.rho / RHO_WATER
     middle = np.abs(p.y - 50.0) < 15.0
@@ -132,6 +137,11 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if len(set(args.spacings)) < 2:
         ap.error(f"--spacings: an observed order needs two spacings or more, got {args.spacings}")
+    for excess in args.excess:
+        try:
+            Refinement(mode=args.mode, smoothing_excess=excess)
+        except InputError as err:
+            ap.error(f"--excess: {err}")
     dipole = split_column_dipole()
     dipole_line = ("one split column in a lake at rest, depth {depth} m: daughters "
                    "{0:.3f}-{1:.3f} m, unsplit particles beside them {2:.3f}-{3:.3f} m").format(
