@@ -172,6 +172,9 @@ def main(argv=None) -> None:
                     help="run the lake in the parabolic bowl this long [s] (0: not at all)")
     ap.add_argument("--bowl-every", type=float, default=100.0, help="its report interval [s]")
     args = ap.parse_args(argv)
+    if args.bowl_end_time < 0.0 or args.bowl_every <= 0.0:
+        ap.error(f"--bowl-end-time must be >= 0 and --bowl-every > 0, got "
+                 f"{args.bowl_end_time:g} and {args.bowl_every:g}")
     print("| kappa | lowest curvature | lattice |\n| --- | --- | --- |")
     for kappa in args.kappa:
         c = lowest_curvature(kappa, args.patch)
