@@ -56,9 +56,9 @@ def test_a_refined_dam_break_with_local_steps_matches_the_global_step_with_less_
     glob = cases.ritter(10.0, refinement=Refinement())
     loc = cases.ritter(10.0, refinement=Refinement(), time_stepping="local")
     assert loc.mass_error_rel < 1e-12
-    assert loc.l1 <= 1.05 * glob.l1  # measured 0.968 % against 0.971 %
-    assert abs(loc.front_error_m) <= 2 * 10.0  # measured 1 m behind (global: 9 m)
-    assert loc.particle_steps < 0.8 * glob.particle_steps  # measured 0.72
+    assert loc.l1 <= 1.05 * glob.l1  # measured 0.76 % against 0.86 %
+    assert abs(loc.front_error_m) <= 2 * 10.0  # measured 16 m behind (global: 23 m)
+    assert loc.particle_steps < 0.8 * glob.particle_steps  # measured 0.73
 
 
 def test_a_column_collapsing_in_a_closed_box_keeps_its_mass_and_stays_inside_with_local_steps():
@@ -92,7 +92,7 @@ def test_local_steps_conserve_momentum_to_the_order_of_the_step():
     assert model.volume_out == 0.0
     assert model.counters["particle_updates"] < 0.9 * model.steps * p.n  # measured 0.49
     mom = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
-    assert np.abs(mom - mom0).max() < 0.005 * math.hypot(*mom0)  # measured 0.09 %
+    assert np.abs(mom - mom0).max() < 0.005 * math.hypot(*mom0)  # measured 0.11 %
 
 
 def test_numerics_reject_an_unknown_time_stepping():

@@ -203,8 +203,8 @@ def test_lake_at_rest_over_a_bump_stays_at_rest():
 
 @pytest.mark.xfail(strict=True, reason="issue 2: with the shore balance the level holds to 1 % and "
                    "the shore in place, but where the lattice meets the round shore in steps "
-                   "the shore rows are not at rest: after 200 s 2.3 cm/s (95th percentile), "
-                   "7.8 cm/s at the shore (3.7 cm/s at kappa 1.3; 0.97 m/s without the "
+                   "the shore rows are not at rest: after 200 s 2.2 cm/s (95th percentile), "
+                   "7.7 cm/s at the shore (3.7 cm/s at kappa 1.3; 0.97 m/s without the "
                    "balance), and the shore's motion grows on longer runs")
 def test_lake_at_rest_in_a_parabolic_bowl_stays_at_rest():
     bowl = lambda x, y: 10.0 * ((x - 500) ** 2 + (y - 500) ** 2) / 500.0**2  # noqa: E731
