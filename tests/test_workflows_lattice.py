@@ -32,10 +32,10 @@ def test_the_seeding_lattice_is_a_minimum_of_the_sph_energy_at_the_default_kappa
 def test_still_water_on_a_disturbed_lattice_settles_at_the_default_kappa(kappa, vmax):
     """10 m of still water on a flat, frictionless 600 m square, the lattice of 20 m particles
     disturbed by 2 cm at random, 480 s. At the default kappa = 1.2 the lattice is a minimum
-    of the SPH energy and the lake stays still: max speed 1.4 mm/s (0.7-2.3 mm/s from 80 to
+    of the SPH energy and the lake stays still: max speed 0.6 mm/s (0.6-1.7 mm/s from 80 to
     640 s: the first disturbance sloshing, with nothing to damp it). At 1.3, the default
-    before, the lattice is a saddle and the lake stirs itself up: 0.12 m/s (3 mm/s at 80 s,
-    0.13 m/s at 400 s)."""
+    before, the lattice is a saddle and the lake stirs itself up: 3.4 cm/s (2.9 mm/s at 80 s,
+    5.4 cm/s at 240 s)."""
     (_, speed), = lattice.still_lake(kappa, 480.0, side=600.0, every=480.0)
     if vmax is None:
         assert speed > 0.02

@@ -25,7 +25,7 @@ still or starts to stir itself after a few minutes.
 
 Measured (README): of the kappa values tried, only 1.2 and 1.22 make the lattice a minimum;
 it is a saddle at 1.0, 1.1, 1.15, 1.18, 1.25, 1.3, 1.4, 1.5, 1.6, 1.8 and 2.0. At 1.3 the
-still lake reaches 0.15 m/s within 500 s; at 1.2 it settles below 1 mm/s.
+still lake reaches 5 cm/s within 240 s and 0.10 m/s by 640 s; at 1.2 it stays below 2 mm/s.
 
 Measured (README, *Known limits*; ``--bowl-end-time 800 --bowl-every 200``): in the bowl the
 shore rows reach 0.044 m/s at 200 s and 0.61 m/s at 400 s, and the level is 1.06 m off at
