@@ -228,7 +228,8 @@ class Refiner:
         idx = np.flatnonzero(big)
         if idx.size == 0:
             return idx
-        x, y, _ = self._daughter_positions(p, idx, model.numerics.kappa)
+        h_parent = _parent_h(p, idx, model.numerics.kappa, s.smoothing_excess)
+        x, y, _ = _daughter_positions(p, idx, h_parent)
         walled = model.closed_edges is not False
         ok = _on_terrain(model.terrain, x, y, nodata_ok=walled)
         ok = ok.reshape(-1, refine.DAUGHTERS).all(axis=1)
@@ -244,16 +245,6 @@ class Refiner:
             ok &= clear
         return idx[ok]
 
-    def _daughter_positions(self, p, idx, kappa):
-        from floodsph.sph import refine
-
-        n = refine.DAUGHTERS * idx.size
-        x, y, m = np.empty(n), np.empty(n), np.empty(n)
-        refine.daughters(p.x[idx], p.y[idx], p.u[idx], p.v[idx], p.m[idx],
-                         _parent_h(p, idx, kappa, self.settings.smoothing_excess), refine.EPS,
-                         refine.STILL_SPEED, x, y, m)
-        return x, y, m
-
     def _split(self, model, idx) -> dict | None:
         """Fields of the daughters of the parents ``idx`` (None if there are none)."""
         from floodsph.sph import refine
@@ -261,11 +252,10 @@ class Refiner:
         if idx.size == 0:
             return None
         p = model.particles
-        x, y, m = self._daughter_positions(p, idx, model.numerics.kappa)
+        h_parent = _parent_h(p, idx, model.numerics.kappa, self.settings.smoothing_excess)
+        x, y, m = _daughter_positions(p, idx, h_parent)
         rep = np.repeat(idx, refine.DAUGHTERS)
-        h = refine.H_FACTOR * np.repeat(
-            _parent_h(p, idx, model.numerics.kappa, self.settings.smoothing_excess),
-            refine.DAUGHTERS)
+        h = refine.H_FACTOR * np.repeat(h_parent, refine.DAUGHTERS)
         rho = p.rho[rep]
         return dict(x=x, y=y, u=p.u[rep], v=p.v[rep], m=m, rho=rho, h=h, h0=h, rho0=rho,
                     alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, model.steps),
@@ -414,6 +404,19 @@ def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE,
         f = np.sqrt((target[over] / c[over]) ** rate)
         p.h0[over] *= f
         p.h[over] *= f
+
+
+def _daughter_positions(p, idx, h_parent: np.ndarray):
+    """Positions [m] and masses [kg] of the seven daughters of each parent ``idx``: a centre and
+    a hexagon of radius eps h_parent [m], turned along the parent's velocity
+    (``floodsph.sph.refine.daughters``, method notes 4)."""
+    from floodsph.sph import refine
+
+    n = refine.DAUGHTERS * idx.size
+    x, y, m = np.empty(n), np.empty(n), np.empty(n)
+    refine.daughters(p.x[idx], p.y[idx], p.u[idx], p.v[idx], p.m[idx], h_parent, refine.EPS,
+                     refine.STILL_SPEED, x, y, m)
+    return x, y, m
 
 
 def _parent_h(p, idx, kappa: float, excess: float) -> np.ndarray:
