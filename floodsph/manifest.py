@@ -2,27 +2,29 @@
 
 Keys (contract, ``scenario-format.md``): ``floodsph_version``, ``scenario`` (the resolved
 scenario), ``status`` (``"running"`` while the run is under way, then ``"completed"``,
-``"interrupted"`` or ``"failed"``), ``sim_time_s``, ``wall_time_s``, ``steps``,
+``"stopped"`` (``--max-steps`` reached first), ``"interrupted"`` or ``"failed"``),
+``sim_time_s``, ``wall_time_s``, ``steps``,
 ``particles_initial``, ``particles_max``, ``particles_final``, ``splits``, ``merges``,
 ``mass_error_rel``, ``threads``; and in addition ``error`` (the message of a failed run),
 ``numba_version``, ``python_version``, ``started``/``finished`` (ISO 8601, UTC),
-``particle_spacing_m`` and ``volume_*_m3`` totals.
+``particle_spacing_m``, ``volume_*_m3`` totals, ``warnings`` (input problems a user could
+mean, run anyway), ``checkpoint_time_s`` (the latest checkpoint) and ``resumed_from`` (the
+checkpoint times the run was resumed from).
 
-The file is written atomically (a temporary file in the same folder, then ``os.replace``), so
-a reader never sees half a manifest.
+The file is written atomically (``floodsph.atomic_files``), so a reader never sees half a
+manifest.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import os
 import platform
-import tempfile
 from datetime import UTC, datetime
 from pathlib import Path
 
 from floodsph._version import __version__
+from floodsph.atomic_files import atomic_path
 
 MANIFEST_NAME = "run.json"
 
@@ -71,17 +73,10 @@ def _json_safe(value):
 
 def write_manifest(folder: Path, manifest: dict) -> Path:
     """Write ``manifest`` to ``folder/run.json`` atomically; returns the path."""
-    folder = Path(folder)
-    target = folder / MANIFEST_NAME
-    fd, tmp = tempfile.mkstemp(prefix=".run.", suffix=".json.tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(_json_safe(manifest), f, indent=2, allow_nan=False)
-            f.write("\n")
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    target = Path(folder) / MANIFEST_NAME
+    with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8") as f:
+        json.dump(_json_safe(manifest), f, indent=2, allow_nan=False)
+        f.write("\n")
     return target
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import logging
+from dataclasses import dataclass
 from pathlib import Path
 
 log = logging.getLogger(__name__)
@@ -34,38 +35,46 @@ class MassBalance:
         error = V_domain(t) - (V0 + V_in(t) - V_out(t))      [m3]
         error_rel = |error| / max(V0 + V_in(t), TINY_VOLUME_M3)
 
-    (flood-practice.md 1.5; LISFLOOD-FP's ``.mass`` file). Each row is flushed as written, so
-    the table of an interrupted run is readable up to its last row.
+    (flood-practice.md 1.5; LISFLOOD-FP's ``.mass`` file). The rows are kept (they go into
+    checkpoints) and written by :meth:`write` when the run ends.
     """
 
-    def __init__(self, path: Path, volume_initial: float):
-        self.path = Path(path)
+    def __init__(self, volume_initial: float, rows: list[tuple[float, ...]] | None = None):
         self.volume_initial = float(volume_initial)
-        self.error_rel = 0.0
-        self._file = open(self.path, "w", newline="", encoding="utf-8")
-        self._writer = csv.writer(self._file)
-        self._writer.writerow(MASS_BALANCE_COLUMNS)
+        self.rows: list[tuple[float, ...]] = list(rows or [])
 
-    def budget(self, model) -> tuple[float, float, float, float, float]:
-        """(V_domain, V_in, V_out, error, error_rel) of ``model`` now [m3, -]."""
+    def budget(self, model) -> MassBudget:
+        """The water budget of ``model`` now."""
         v_domain = float(model.volume())
         v_in = float(model.volume_in)
         v_out = float(model.volume_out)
         error = v_domain - (self.volume_initial + v_in - v_out)
         rel = abs(error) / max(self.volume_initial + v_in, TINY_VOLUME_M3)
-        return v_domain, v_in, v_out, error, rel
+        return MassBudget(v_domain, v_in, v_out, error, rel)
 
     def __call__(self, sim) -> None:
-        v_domain, v_in, v_out, error, rel = self.budget(sim.model)
-        self.error_rel = rel
-        self._writer.writerow(
-            [repr(float(sim.model.t)), repr(v_domain), repr(v_in), repr(v_out), repr(error),
-             repr(rel)]
-        )
-        self._file.flush()
+        b = self.budget(sim.model)
+        self.rows.append((float(sim.model.t), b.volume_domain_m3, b.volume_in_m3,
+                          b.volume_out_m3, b.error_m3, b.error_rel))
 
-    def close(self) -> None:
-        self._file.close()
+    def write(self, path: Path) -> Path:
+        """Write the rows as ``mass_balance.csv`` at ``path`` (full precision, ``repr``)."""
+        with open(path, "w", newline="", encoding="utf-8") as f:
+            writer = csv.writer(f)
+            writer.writerow(MASS_BALANCE_COLUMNS)
+            writer.writerows([repr(value) for value in row] for row in self.rows)
+        return Path(path)
+
+
+@dataclass(frozen=True)
+class MassBudget:
+    """The water budget at one time [m3]; ``error_rel`` [-] (:class:`MassBalance`)."""
+
+    volume_domain_m3: float
+    volume_in_m3: float
+    volume_out_m3: float
+    error_m3: float
+    error_rel: float
 
 
 class Progress:

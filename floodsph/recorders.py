@@ -3,25 +3,34 @@
 :class:`Recorders` owns the objects of ``floodsph.output`` for one run, hands their
 ``(callback, schedule)`` pairs to the :class:`~floodsph.simulation.Simulation`, and writes the
 final files (:meth:`Recorders.write`) only when the run completes, so a failed or interrupted
-run never leaves maps that look finished. Snapshots are appended as the run goes; they carry
-the time of each frame and ``run.json`` tells whether the run completed.
+run never leaves maps that look finished. Snapshots are appended as the run goes to
+``snapshots.nc.part``, renamed to ``snapshots.nc`` by :meth:`Recorders.write`.
+:meth:`Recorders.state` and :meth:`Recorders.restore` carry everything recorded so far
+through a checkpoint.
 """
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
+from floodsph.atomic_files import atomic_path
+from floodsph.run_folder import GAUGES_NAME, SNAPSHOTS_NAME
 from floodsph.scenario import Scenario
 from floodsph.schedules import TimeInterval
 
-GAUGES_NAME = "gauges.csv"
-SNAPSHOTS_NAME = "snapshots.nc"
+SNAPSHOTS_PART = SNAPSHOTS_NAME + ".part"
 
 
 class Recorders:
-    """Envelopes (always), gauges (``[gauges]``) and snapshots (``snapshot_interval_s > 0``)."""
+    """Envelopes (always), gauges (``[gauges]``) and snapshots (``snapshot_interval_s > 0``).
 
-    def __init__(self, scenario: Scenario, terrain, gauge_points, out: Path):
+    ``state`` (:meth:`state` of an earlier run) continues that run's records; its snapshot
+    frames are read from ``snapshots_from`` (default: this run's own ``snapshots.nc.part``).
+    """
+
+    def __init__(self, scenario: Scenario, terrain, gauge_points, out: Path,
+                 state: dict | None = None, snapshots_from: Path | None = None):
         from floodsph.output.envelopes import Envelopes
         from floodsph.output.grid import OutputGrid
 
@@ -40,9 +49,22 @@ class Recorders:
             from floodsph.output.netcdf import SnapshotWriter
 
             self.snapshots = SnapshotWriter(
-                self.out / SNAPSHOTS_NAME, self.grid, scenario=scenario.to_dict(),
-                wet_threshold=wet,
+                self.out / SNAPSHOTS_PART, self.grid, scenario=scenario.to_dict(),
+                wet_threshold=wet, keep_frames=0 if state is None else state["snapshot_frames"],
+                source=snapshots_from,
             )
+        if state is not None:
+            self.envelopes.restore(state["envelopes"])
+            if self.gauges is not None:
+                self.gauges.rows = list(state["gauge_rows"])
+                self.gauges.t_last = state["gauge_t_last"]
+
+    def state(self) -> dict:
+        """Everything recorded so far, for a checkpoint (the ``state`` of the constructor)."""
+        return {"envelopes": self.envelopes.state(),
+                "gauge_rows": None if self.gauges is None else list(self.gauges.rows),
+                "gauge_t_last": None if self.gauges is None else self.gauges.t_last,
+                "snapshot_frames": 0 if self.snapshots is None else self.snapshots.frames}
 
     def callbacks(self) -> list:
         """``(callable, schedule)`` pairs for the simulation."""
@@ -75,7 +97,13 @@ class Recorders:
         formats = [f.value for f in self.scenario.output.formats]
         written = write_maps(self.envelopes, self.out, formats, scenario=self.scenario.to_dict())
         if self.gauges is not None:
-            written.append(self.gauges.write_csv(self.out / GAUGES_NAME))
+            with atomic_path(self.out / GAUGES_NAME) as tmp:
+                self.gauges.write_csv(tmp)
+            written.append(self.out / GAUGES_NAME)
+        if self.snapshots is not None:
+            self.close()
+            os.replace(self.out / SNAPSHOTS_PART, self.out / SNAPSHOTS_NAME)
+            written.append(self.out / SNAPSHOTS_NAME)
         return written
 
     def write_pictures(self) -> list[str] | str:

@@ -1,57 +1,37 @@
 """``run_scenario``: one scenario from its TOML to a finished run folder.
 
-The chain (architecture.md 3.2): inputs (terrain, particles, hydrographs; every input check
-happens here, before the run folder is touched) -> run folder (``floodsph.log``,
-``scenario.resolved.toml``, ``run.json`` with status ``"running"``) -> ``FloodModel`` ->
-``Simulation`` with the mass-balance, progress and recorder callbacks (map envelopes,
-gauges, snapshots: ``floodsph.recorders``) -> maps and gauges (written only when the run
-completes) -> ``run.json`` with the final status.
+The chain (architecture.md 3.2): the run folder is checked (``floodsph.run_folder``: nothing
+that is not a floodsph run's, no completed run unless replaced) -> inputs (terrain,
+particles, hydrographs; every input check happens here, before the run folder is touched)
+-> the folder is locked and opened (``floodsph.log``, ``scenario.resolved.toml``,
+``run.json`` with status ``"running"``) -> ``FloodModel`` (or the one of a checkpoint) ->
+``Simulation`` with the mass-balance, progress, recorder and checkpoint callbacks -> maps,
+gauges and mass balance (written under temporary names, then renamed) -> ``run.json`` last.
 
-``run.json`` is rewritten (atomically) however the run ends: ``"completed"``,
-``"interrupted"`` (Ctrl-C; the KeyboardInterrupt is re-raised) or ``"failed"`` (the exception
-is re-raised, its message is in ``error``). A folder holding a completed run is refused unless
-``overwrite=True``; known output files of an earlier run are deleted before a new run starts,
-so no stale map survives next to a new manifest.
+``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached
+before the end time); ``"interrupted"`` (SIGINT, SIGTERM or SIGHUP: ``floodsph.stop_signals``;
+once the time loop runs, a checkpoint is written first and the manifest is returned);
+``"failed"`` (the exception is re-raised, its one-line message is in ``error``). A run that
+replaces a completed one is built in ``.floodsph-new/`` and swapped in when it completes.
 """
 
 from __future__ import annotations
 
 import logging
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
+from floodsph.atomic_files import atomic_path
 from floodsph.errors import InputError
-from floodsph.manifest import new_manifest, now_iso, read_manifest, write_manifest
+from floodsph.manifest import new_manifest, now_iso, write_manifest
+from floodsph.run_folder import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME, RunFolder
 from floodsph.scenario import Edges, Scenario, write_resolved
 from floodsph.schedules import time_tolerance
+from floodsph.stop_signals import StopSignals
 
 log = logging.getLogger(__name__)
 
-LOG_NAME = "floodsph.log"
-#: Quick-look PNGs written by ``floodsph.output.write_pictures`` when matplotlib is installed.
-PICTURE_NAMES = ("max_depth.png", "hazard_uk.png", "hazard_arr.png", "arrival_time.png")
-RESOLVED_NAME = "scenario.resolved.toml"
-MASS_BALANCE_NAME = "mass_balance.csv"
-#: Files of the run folder (scenario-format.md) removed before a new run writes its own.
-RUN_FILES = (
-    "max_depth.tif",
-    "max_speed.tif",
-    "max_unit_discharge.tif",
-    "max_level.tif",
-    "arrival_time.tif",
-    "time_of_max_depth.tif",
-    "duration.tif",
-    "hazard_uk.tif",
-    "hazard_arr.tif",
-    "flood_maps.nc",
-    "snapshots.nc",
-    "gauges.csv",
-    MASS_BALANCE_NAME,
-    "run.json",
-    RESOLVED_NAME,
-    LOG_NAME,
-    *PICTURE_NAMES,
-)
 PROGRESS_BAR_S = 0.5
 PROGRESS_LOG_S = 30.0
 
@@ -64,6 +44,7 @@ def run_scenario(
     overwrite: bool = False,
     threads: int | None = None,
     callbacks=(),
+    resume: bool = False,
 ) -> dict:
     """Run ``scenario`` and write its run folder; return the manifest (``run.json``).
 
@@ -73,102 +54,190 @@ def run_scenario(
     out_dir : path, optional
         The run folder; default ``scenario.output_directory`` (``out/<name>``).
     max_steps : int, optional
-        Stop after this many steps (a trial run; ``run.json`` has ``end_time_reached``).
+        Stop after this many steps (a trial run: status ``"stopped"`` unless the end time
+        came first).
     progress : bool
         Show the progress bar (it is off anyway when stderr is not a terminal).
     overwrite : bool
-        Replace a completed run in ``out_dir``.
+        Replace a completed (or checkpointed) run in ``out_dir``; the old one stays until the
+        new one completes.
     threads : int, optional
         Numba threads; default ``numerics.threads`` (0 = all cores).
     callbacks : sequence of (callable, schedule)
         Extra callbacks for the :class:`~floodsph.simulation.Simulation`.
+    resume : bool
+        Continue from the latest checkpoint in ``out_dir``; the scenario must equal the
+        checkpointed one but for a later ``end_time_s``.
 
     Raises
     ------
     InputError
-        Bad input, an existing completed run, or a run too large for the available memory.
+        Bad input, a run folder the run may not write, or a run too large for the memory.
     """
     from floodsph.inputs import prepare_inputs
     from floodsph.memory import check_memory
 
+    if overwrite and resume:
+        raise InputError("--overwrite and --resume exclude each other: resume continues the "
+                         "run in the folder, overwrite replaces it")
     out = Path(out_dir) if out_dir is not None else scenario.output_directory
-    _check_folder(out, overwrite)
-    used_threads = set_threads(scenario.numerics.threads if threads is None else threads)
-    inputs = prepare_inputs(scenario)
-    check_memory(inputs.memory, str(scenario.path.name))
+    folder = RunFolder(out, scenario.input_files(), overwrite=overwrite, resume=resume)
+    folder.check()
+    with StopSignals() as stop:
+        used_threads = set_threads(scenario.numerics.threads if threads is None else threads)
+        inputs = prepare_inputs(scenario)
+        check_memory(inputs.memory, str(scenario.path.name))
+        checkpoint = _resumable(folder, scenario, inputs, used_threads) if resume else None
+        work = folder.open()
+        try:
+            return _run(scenario, inputs, folder, work, checkpoint, stop,
+                        RunOptions(max_steps, progress, used_threads, tuple(callbacks)))
+        finally:
+            folder.close()
 
-    out.mkdir(parents=True, exist_ok=True)
-    for name in RUN_FILES:
-        (out / name).unlink(missing_ok=True)
-    for path in out.glob("breach_hydrograph_*.csv"):
-        path.unlink()
-    log_handler = _attach_log(out / LOG_NAME)
+
+@dataclass(frozen=True)
+class RunOptions:
+    """The caller's settings of one run (:func:`run_scenario`)."""
+
+    max_steps: int | None
+    progress: bool
+    threads: int
+    callbacks: tuple
+
+
+def _resumable(folder: RunFolder, scenario: Scenario, inputs, threads: int):
+    """The checkpoint to resume from, refused unless the scenario is the same."""
+    from floodsph.checkpoint import load_checkpoint, scenario_difference
+
+    directory = folder.checkpoint_dir()
+    checkpoint = load_checkpoint(directory, inputs.terrain)
+    where = scenario_difference(checkpoint.scenario, scenario.to_dict())
+    if where is not None:
+        raise InputError(f"{scenario.path}: {where} differs from the checkpointed run's "
+                         f"({directory}); only scenario.end_time_s may change on --resume")
+    if checkpoint.t >= scenario.end_time_s - time_tolerance(scenario.end_time_s):
+        raise InputError(f"{scenario.path}: scenario.end_time_s = {scenario.end_time_s:g} s "
+                         f"is not after the checkpoint at t = {checkpoint.t:g} s; raise it "
+                         "to extend the run")
+    if checkpoint.threads != threads:
+        log.warning("the checkpoint was written with %d threads, this run has %d: the resumed "
+                    "run may differ from an uninterrupted one in the last digits",
+                    checkpoint.threads, threads)
+    return checkpoint
+
+
+def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
+    """The run proper, in the opened folder ``work``; see :func:`run_scenario`."""
+    log_handler = _attach_log(work / LOG_NAME, append=checkpoint is not None)
     manifest = new_manifest(scenario.to_dict())
     manifest.update(
-        threads=used_threads,
+        threads=opts.threads,
         particle_spacing_m=inputs.spacing_m,
         particles_initial=inputs.particles.n,
         volume_initial_m3=inputs.volume_initial_m3,
-        max_steps=max_steps,
+        max_steps=opts.max_steps,
+        warnings=list(getattr(inputs, "warnings", [])),
+        resumed_from=[] if checkpoint is None else [*checkpoint.resumed_from, checkpoint.t],
+        checkpoint_time_s=None if checkpoint is None else checkpoint.t,
     )
-    wall_start = time.monotonic()
-    model = None
-    probes = ()
+    wall_start = time.monotonic() - (0.0 if checkpoint is None else checkpoint.wall_time_s)
+    model = mass = recorders = None
     try:
-        write_resolved(scenario, out / RESOLVED_NAME)
-        manifest["breach_hydrographs"] = write_inflow_hydrographs(scenario, inputs, out)
-        write_manifest(out, manifest)
-        log.info("run folder %s; %d particles, spacing %g m", out, inputs.particles.n,
+        with atomic_path(work / RESOLVED_NAME) as tmp:
+            write_resolved(scenario, tmp)
+        manifest["breach_hydrographs"] = write_inflow_hydrographs(scenario, inputs, work)
+        write_manifest(work, manifest)
+        log.info("run folder %s; %d particles, spacing %g m", folder.path, inputs.particles.n,
                  inputs.spacing_m)
-        model = build_model(scenario, inputs)
-        manifest["seeds_settled"] = model.counters["seeds_settled"]
-        manifest["volume_seed_adjustment_m3"] = model.volume_seed_adjustment
-        if model.counters["seeds_settled"]:
-            log.info("%d seeds settled next to walls in %d rounds; volume adjusted by %.6g m3",
-                     model.counters["seeds_settled"], model.counters["settle_steps"],
-                     model.volume_seed_adjustment)
-        probes, sim = _simulation(scenario, inputs, model, out, max_steps, progress, callbacks)
+        if checkpoint is None:
+            model = build_model(scenario, inputs)
+        else:
+            model = checkpoint.model
+            log.info("resumed from the checkpoint at t = %g s (step %d)", model.t, model.steps)
+        _record_setup(manifest, model)
+        mass, recorders, sim = _simulation(scenario, inputs, model, folder, opts, checkpoint,
+                                           stop, manifest, wall_start)
+        stop.armed = True
         sim.run()
-        for probe in probes:
-            probe.close()
-        written = probes[-1].write()
-        log.info("wrote %d map and gauge files", len(written))
-        manifest["pictures"] = probes[-1].write_pictures()
-        if isinstance(manifest["pictures"], str):
-            log.warning("quick-look %s", manifest["pictures"])
-        manifest["status"] = "completed"
-        manifest["end_time_reached"] = model.t >= scenario.end_time_s - time_tolerance(
-            scenario.end_time_s
-        )
-    except KeyboardInterrupt:
+        if sim.interrupted:
+            path = _save(sim, scenario, opts.threads, manifest, mass, recorders, work,
+                         wall_start)
+            manifest["status"] = "interrupted"
+            manifest["error"] = f"interrupted by {stop.requested}; checkpoint {path}"
+            log.warning("run interrupted at t = %g s: %s", model.t, manifest["error"])
+        else:
+            _write_outputs(manifest, recorders, mass, work)
+            reached = model.t >= scenario.end_time_s - time_tolerance(scenario.end_time_s)
+            manifest["status"] = "completed" if reached else "stopped"
+            manifest["end_time_reached"] = reached
+    except KeyboardInterrupt as exc:
         manifest["status"] = "interrupted"
-        manifest["error"] = "interrupted by the user (KeyboardInterrupt)"
+        manifest["error"] = str(exc) or "interrupted by the user (KeyboardInterrupt)"
         log.warning("run interrupted at t = %s s", None if model is None else model.t)
         raise
     except BaseException as exc:
         manifest["status"] = "failed"
-        manifest["error"] = str(exc) if isinstance(exc, InputError) else (
-            f"{type(exc).__name__}: {exc}")
+        manifest["error"] = error_message(exc)
         log.error("run failed: %s", manifest["error"])
         raise
     finally:
-        for probe in probes:
-            probe.close()
-        _finish_manifest(manifest, model, probes, time.monotonic() - wall_start)
-        write_manifest(out, manifest)
-        log.info("run %s: wrote %s", manifest["status"], out / "run.json")
+        if recorders is not None:
+            recorders.close()
+        _finish_manifest(manifest, model, mass, time.monotonic() - wall_start)
+        _final_manifest(folder, work, manifest)
         _detach_log(*log_handler)
     return manifest
 
 
-def _check_folder(out: Path, overwrite: bool) -> None:
-    """Refuse to replace a completed run unless asked to."""
-    previous = read_manifest(out)
-    if previous is not None and previous.get("status") == "completed" and not overwrite:
-        raise InputError(
-            f"{out}: already holds a completed run (run.json); pass --overwrite to replace it "
-            "or choose another --output folder"
-        )
+def error_message(exc: BaseException) -> str:
+    """The one line a user sees for ``exc``: the message of an input or simulation error,
+    the file and reason of an OS error (a full disk, say), else the type and message."""
+    from floodsph.simulation import SimulationError
+
+    if isinstance(exc, InputError):
+        return str(exc)
+    if isinstance(exc, SimulationError):
+        return f"the simulation failed: {exc}"
+    if isinstance(exc, OSError) and exc.strerror:
+        where = f"{exc.filename}: " if exc.filename else ""
+        return f"{where}{exc.strerror}"
+    return f"{type(exc).__name__}: {exc}"
+
+
+def _record_setup(manifest: dict, model) -> None:
+    manifest["seeds_settled"] = model.counters["seeds_settled"]
+    manifest["volume_seed_adjustment_m3"] = model.volume_seed_adjustment
+    if model.counters["seeds_settled"]:
+        log.info("%d seeds settled next to walls in %d rounds; volume adjusted by %.6g m3",
+                 model.counters["seeds_settled"], model.counters["settle_steps"],
+                 model.volume_seed_adjustment)
+
+
+def _write_outputs(manifest: dict, recorders, mass, work: Path) -> None:
+    """Maps, gauges, snapshots, mass balance and quick-looks of a run that ended its loop."""
+    written = recorders.write()
+    with atomic_path(work / MASS_BALANCE_NAME) as tmp:
+        mass.write(tmp)
+    log.info("wrote %d map and table files", len(written) + 1)
+    manifest["pictures"] = recorders.write_pictures()
+    if isinstance(manifest["pictures"], str):
+        log.warning("quick-look %s", manifest["pictures"])
+
+
+def _final_manifest(folder: RunFolder, work: Path, manifest: dict) -> None:
+    """Write ``run.json`` last (a completed replacement is then swapped in, ``run.json`` last
+    again). A manifest that cannot be written (a full disk) is logged, not raised over the
+    run's own error."""
+    try:
+        write_manifest(work, manifest)
+        if manifest["status"] in ("completed", "stopped"):
+            folder.swap_in()
+        log.info("run %s: wrote %s", manifest["status"], folder.work / "run.json")
+    except OSError as exc:
+        log.error("run.json could not be written: %s", error_message(exc))
+        if manifest["status"] != "failed":
+            raise
 
 
 def set_threads(threads: int) -> int:
@@ -256,34 +325,69 @@ def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]
                                                  strict=True)):
         if inflow.breach is not None:
             name = f"breach_hydrograph_{i}.csv"
-            write_hydrograph_csv(out / name, hydrograph.t, hydrograph.Q)
+            with atomic_path(out / name) as tmp:
+                write_hydrograph_csv(tmp, hydrograph.t, hydrograph.Q)
             names.append(name)
     return names
 
 
-def _simulation(scenario, inputs, model, out, max_steps, progress, extra):
-    """The Simulation and its probes (mass balance, progress bar, recorders; closed by caller)."""
+def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifest, wall_start):
+    """The mass balance, the recorders and the Simulation with every callback.
+
+    The checkpoint callback comes last, so that a checkpoint holds what every other callback
+    recorded at its step.
+    """
     from floodsph.probes import MassBalance, Progress, log_progress
     from floodsph.recorders import Recorders
     from floodsph.schedules import TimeInterval, WallTimeInterval
     from floodsph.simulation import Simulation
 
-    mass = MassBalance(out / MASS_BALANCE_NAME,
-                       inputs.volume_initial_m3 + model.volume_seed_adjustment)
-    bar = Progress(scenario.end_time_s, enabled=progress)
-    recorders = Recorders(scenario, inputs.terrain, inputs.gauges, out)
+    work = folder.work
+    state = None if checkpoint is None else checkpoint.recorders
+    mass = MassBalance(inputs.volume_initial_m3 + model.volume_seed_adjustment,
+                       None if checkpoint is None else checkpoint.mass_rows)
+    bar = Progress(scenario.end_time_s, enabled=opts.progress)
+    recorders = Recorders(scenario, inputs.terrain, inputs.gauges, work, state=state,
+                          snapshots_from=folder.finished_snapshots())
     callbacks = [
         (mass, TimeInterval(scenario.output.mass_balance_interval_s)),
         *recorders.callbacks(),
         (bar, WallTimeInterval(PROGRESS_BAR_S)),
         (log_progress, WallTimeInterval(PROGRESS_LOG_S)),
-        *extra,
+        *opts.callbacks,
     ]
-    probes = (mass, bar, recorders)
-    return probes, Simulation(model, scenario.end_time_s, callbacks, max_steps=max_steps)
+    interval = scenario.output.checkpoint_interval_s
+    if interval > 0:
+        def write_checkpoint(sim) -> None:
+            if sim.model.steps > 0:
+                _save(sim, scenario, opts.threads, manifest, mass, recorders, work, wall_start)
+                write_manifest(work, manifest)
+
+        callbacks.append((write_checkpoint, TimeInterval(interval, align=False)))
+    sim = Simulation(model, scenario.end_time_s, callbacks, max_steps=opts.max_steps,
+                     should_stop=stop)
+    if checkpoint is not None:
+        sim.restore(checkpoint.simulation)
+    return mass, recorders, sim
 
 
-def _finish_manifest(manifest: dict, model, probes, wall_time: float) -> None:
+def _save(sim, scenario, threads, manifest, mass, recorders, work, wall_start) -> Path:
+    """Write a checkpoint of the run now; ``manifest`` gets its time."""
+    from floodsph.checkpoint import Checkpoint, save_checkpoint
+
+    model = sim.model
+    checkpoint = Checkpoint(scenario=scenario.to_dict(), threads=threads, model=model,
+                            simulation=sim.state(), recorders=recorders.state(),
+                            mass_rows=list(mass.rows), resumed_from=manifest["resumed_from"],
+                            wall_time_s=time.monotonic() - wall_start)
+    path = save_checkpoint(work, checkpoint, model.terrain)
+    manifest["checkpoint_time_s"] = float(model.t)
+    _finish_manifest(manifest, model, mass, time.monotonic() - wall_start)
+    log.info("checkpoint at t = %g s (step %d): %s", model.t, model.steps, path)
+    return path
+
+
+def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
     manifest["finished"] = now_iso()
     manifest["wall_time_s"] = wall_time
     if model is None:
@@ -302,8 +406,8 @@ def _finish_manifest(manifest: dict, model, probes, wall_time: float) -> None:
         volume_out_m3=float(model.volume_out),
         inflows=[_inflow_summary(b) for b in model.boundaries if hasattr(b, "pending")],
     )
-    if probes:
-        manifest["mass_error_rel"] = probes[0].budget(model)[4]
+    if mass is not None:
+        manifest["mass_error_rel"] = mass.budget(model).error_rel
 
 
 def _inflow_summary(inflow) -> dict:
@@ -315,12 +419,13 @@ def _inflow_summary(inflow) -> dict:
     }
 
 
-def _attach_log(path: Path) -> tuple[logging.Handler, int]:
-    """Send floodsph's INFO (and higher) records to ``path`` for the length of the run.
+def _attach_log(path: Path, append: bool = False) -> tuple[logging.Handler, int]:
+    """Send floodsph's INFO (and higher) records to ``path`` for the length of the run
+    (appended to a resumed run's log).
 
     Returns the handler and the logger level to restore afterwards.
     """
-    handler = logging.FileHandler(path, encoding="utf-8")
+    handler = logging.FileHandler(path, mode="a" if append else "w", encoding="utf-8")
     handler.setLevel(logging.INFO)
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     logger = logging.getLogger("floodsph")

@@ -186,7 +186,12 @@ class NumericsConfig:
 
 @dataclass(frozen=True)
 class OutputConfig:
-    """``[output]``: where and what to write. ``directory = None`` means ``out/<name>``."""
+    """``[output]``: where and what to write. ``directory = None`` means ``out/<name>``.
+
+    ``checkpoint_interval_s`` [s of simulated time] > 0 writes a checkpoint at the first step
+    at or after each multiple of it (``floodsph.checkpoint``); 0 writes none on a schedule
+    (a stop signal still writes one).
+    """
 
     directory: Path | None = None
     resolution_m: float | None = None
@@ -194,6 +199,7 @@ class OutputConfig:
     formats: tuple[OutputFormat, ...] = (OutputFormat.GEOTIFF, OutputFormat.NETCDF)
     snapshot_interval_s: float = 0.0
     mass_balance_interval_s: float = 10.0
+    checkpoint_interval_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -225,6 +231,16 @@ class Scenario:
         if self.output.directory is not None:
             return self.output.directory
         return self.path.parent / "out" / self.name
+
+    def input_files(self) -> tuple[Path, ...]:
+        """The scenario file and every file it reads (a run never writes over them)."""
+        t = self.terrain
+        files = [self.path, t.dem, t.landcover, t.manning_table,
+                 t.manning if isinstance(t.manning, Path) else None,
+                 *(w.depth for w in self.initial_water),
+                 *(i.hydrograph for i in self.inflows),
+                 None if self.gauges is None else self.gauges.file]
+        return tuple(f for f in files if f is not None)
 
     def to_dict(self) -> dict:
         """The resolved scenario as plain JSON/TOML-able data (paths absolute, defaults filled).
@@ -540,6 +556,8 @@ def _output(r: Reader, data: dict) -> OutputConfig:
         mass_balance_interval_s=r.number(
             t, p, "mass_balance_interval_s", d.mass_balance_interval_s, gt=0.0
         ),
+        checkpoint_interval_s=r.number(t, p, "checkpoint_interval_s",
+                                       d.checkpoint_interval_s, ge=0.0),
     )
 
 

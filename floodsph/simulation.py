@@ -10,6 +10,11 @@ a step, and once at the end (the final state) unless it already ran on the last 
 step is shortened so that the model lands exactly on the end time and on every
 :class:`~floodsph.schedules.TimeInterval` time. After every step a guard checks that depth,
 velocity and position are finite and depth is not negative.
+
+A stop request (``should_stop``, e.g. a SIGTERM caught by ``floodsph.stop_signals``) ends the
+loop after the step and its callbacks, without the final calls: :meth:`Simulation.state` is
+then exactly what a run that was never stopped had at that step, and a simulation given that
+state by :meth:`Simulation.restore` continues as that run would (checkpoint and resume).
 """
 
 from __future__ import annotations
@@ -42,6 +47,9 @@ class Simulation:
         ``callable(sim)`` runs when ``schedule.due(sim)``; see the module docstring.
     max_steps : int, optional
         Stop after this many steps even before ``end_time`` (for trial runs).
+    should_stop : callable, optional
+        ``should_stop() -> bool``, asked after every step; True ends the loop
+        (:attr:`interrupted`).
     """
 
     def __init__(
@@ -50,6 +58,7 @@ class Simulation:
         end_time: float,
         callbacks: Sequence[tuple[Callable, object]] = (),
         max_steps: int | None = None,
+        should_stop: Callable[[], bool] | None = None,
     ):
         if not end_time > 0:
             raise ValueError(f"end_time must be > 0, got {end_time}")
@@ -57,9 +66,13 @@ class Simulation:
         self.end_time = float(end_time)
         self.callbacks = list(callbacks)
         self.max_steps = max_steps
+        self.should_stop = should_stop
+        self.interrupted = False
         self.steps_taken = 0
         self.last_dt = 0.0
         self.wall_start = time.monotonic()
+        self.last_call: list[int] | None = None
+        self._restored: dict | None = None
 
     @property
     def wall_time(self) -> float:
@@ -82,15 +95,35 @@ class Simulation:
                     if isinstance(s, TimeInterval) and s.align]
         return min(target - t for target in targets if target > t + time_tolerance(target))
 
+    def state(self) -> dict:
+        """What the loop needs to continue: the step each callback last ran at, the next
+        time of each TimeInterval, and the last step [s]."""
+        return {"last_call": list(self.last_call or []), "last_dt": self.last_dt,
+                "next_times": [getattr(s, "next_time", None) for _, s in self.callbacks]}
+
+    def restore(self, state: dict) -> None:
+        """Continue from :meth:`state` of a simulation with the same callbacks: :meth:`run`
+        then skips the initial calls."""
+        if len(state["last_call"]) != len(self.callbacks):
+            raise ValueError("the saved simulation state has another set of callbacks")
+        self._restored = state
+
     def run(self) -> None:
-        """Step until finished; callbacks at start, when due, and at the end."""
+        """Step until finished or stopped; callbacks at start, when due, and at the end."""
         self.wall_start = time.monotonic()
         for _, schedule in self.callbacks:
             schedule.reset(self)
-        last_call = {}
-        for k, (func, _) in enumerate(self.callbacks):
-            func(self)
-            last_call[k] = self.model.steps
+        if self._restored is None:
+            self.last_call = [self.model.steps] * len(self.callbacks)
+            for func, _ in self.callbacks:
+                func(self)
+        else:
+            self.last_call = list(self._restored["last_call"])
+            self.last_dt = self._restored["last_dt"]
+            for (_, schedule), next_time in zip(self.callbacks, self._restored["next_times"],
+                                                strict=True):
+                if next_time is not None:
+                    schedule.next_time = next_time
         log.info("simulation started: end time %g s, %d particles", self.end_time, self.n)
         while not self.finished:
             self.last_dt = self.model.step(dt_max=self.dt_max())
@@ -98,10 +131,16 @@ class Simulation:
             self.check_state()
             for k, (func, schedule) in enumerate(self.callbacks):
                 if schedule.due(self):
+                    self.last_call[k] = self.model.steps
                     func(self)
-                    last_call[k] = self.model.steps
+            if self.should_stop is not None and self.should_stop():
+                self.interrupted = True
+                log.warning("stop requested: the loop ends at t = %g s, step %d", self.model.t,
+                            self.model.steps)
+                return
         for k, (func, _) in enumerate(self.callbacks):
-            if last_call[k] != self.model.steps:
+            if self.last_call[k] != self.model.steps:
+                self.last_call[k] = self.model.steps
                 func(self)
         log.info(
             "simulation ended at t = %g s after %d steps (%.1f s wall)",

@@ -202,7 +202,7 @@ def test_run_writes_manifest_and_mass_balance(scenario_file):
                 "particles_initial", "particles_max", "particles_final", "splits", "merges",
                 "mass_error_rel", "threads"):
         assert key in manifest
-    assert manifest["status"] == "completed" and manifest["end_time_reached"] is False
+    assert manifest["status"] == "stopped" and manifest["end_time_reached"] is False
     assert manifest["steps"] == 3
     assert manifest["particles_initial"] == 10 * NY
     assert manifest["scenario"]["scenario"]["name"] == "valley"
@@ -228,7 +228,7 @@ def test_run_writes_manifest_and_mass_balance(scenario_file):
     assert "run folder" in (folder / "floodsph.log").read_text()
 
     again = invoke("run", scenario_file, "--max-steps", "1")
-    assert_input_error(again, "already holds a completed run", "--overwrite")
+    assert_input_error(again, "already holds a stopped run", "--overwrite")
     again = invoke("-q", "run", scenario_file, "--max-steps", "1", "--overwrite")
     assert again.exit_code == 0
     assert read_run_json(folder)["steps"] == 1

@@ -78,7 +78,7 @@ def test_run_completes_the_asked_steps_with_closed_mass_budget(sample_run):
     result, out = sample_run
     assert result.exit_code == 0, result.output
     run = json.loads((out / "run.json").read_text())
-    assert run["status"] == "completed"
+    assert run["status"] == "stopped"
     assert run["steps"] == MAX_STEPS
     assert run["end_time_reached"] is False
     assert 0.0 < run["sim_time_s"] < run["scenario"]["scenario"]["end_time_s"]

@@ -17,7 +17,8 @@ Global options (before the command name):
 =================  ==============================================================
 
 Errors: a :class:`floodsph.errors.InputError` is printed as one line on stderr and exits with
-status 2; a failed simulation exits with status 1, an interrupted one (Ctrl-C) with 130.
+status 2; any other failure (the simulation, a full disk, ...) is one line and status 1, an
+interruption (Ctrl-C, SIGTERM, SIGHUP) status 130. ``--debug`` shows the traceback instead.
 """
 
 from __future__ import annotations
@@ -69,15 +70,16 @@ class LazyGroup(click.Group):
                 raise
             click.echo(f"Error: {exc}", err=True)
             ctx.exit(EXIT_INPUT_ERROR)
-        except KeyboardInterrupt:
-            click.echo("Interrupted.", err=True)
+        except KeyboardInterrupt as exc:
+            click.echo(f"Interrupted{': ' + str(exc) if str(exc) else ''}.", err=True)
             ctx.exit(EXIT_INTERRUPTED)
         except Exception as exc:
-            from floodsph.simulation import SimulationError
-
-            if debug or not isinstance(exc, SimulationError):
+            if debug or isinstance(exc, click.ClickException | click.exceptions.Exit
+                                             | click.Abort):
                 raise
-            click.echo(f"Error: the simulation failed: {exc}", err=True)
+            from floodsph.run import error_message
+
+            click.echo(f"Error: {error_message(exc)}", err=True)
             ctx.exit(EXIT_FAILED)
 
 

@@ -6,30 +6,39 @@ from pathlib import Path
 
 import click
 
+#: Exit status of each ending (``floodsph.cli.main`` has those of errors).
+EXIT_STATUS = {"completed": 0, "stopped": 0, "interrupted": 130}
+
 
 @click.command("run")
 @click.argument("scenario", type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
     "-o",
     "--output",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=click.Path(path_type=Path),
     default=None,
     help="Run folder (default: output.directory, or out/<name> beside the scenario).",
 )
-@click.option("--overwrite", is_flag=True, help="Replace a completed run in the run folder.")
+@click.option("--overwrite", is_flag=True,
+              help="Replace the completed run in the run folder (kept until the new one "
+                   "completes).")
+@click.option("--resume", is_flag=True,
+              help="Continue the run in the run folder from its latest checkpoint (a larger "
+                   "scenario.end_time_s extends it).")
 @click.option(
     "--max-steps",
     type=click.IntRange(min=1),
     default=None,
-    help="Stop after this many time steps (a trial run).",
+    help="Stop after this many time steps (a trial run; status \"stopped\").",
 )
 @click.pass_context
-def command(ctx: click.Context, scenario: Path, output, overwrite: bool, max_steps) -> None:
+def command(ctx: click.Context, scenario: Path, output, overwrite: bool, resume: bool,
+            max_steps) -> None:
     """Run SCENARIO (a TOML file): maps, mass balance and run.json in the run folder.
 
-    The run folder gets floodsph.log, scenario.resolved.toml, mass_balance.csv, run.json and,
-    when the run completes, the flood maps. run.json records the status whether the run
-    completes, fails or is interrupted (Ctrl-C).
+    run.json records how the run ended: completed, stopped (--max-steps), interrupted
+    (Ctrl-C, SIGTERM or SIGHUP: a checkpoint is written first; exit status 130) or failed
+    (exit status 1, or 2 for bad input). The maps are written only when the run completes.
     """
     from floodsph.run import run_scenario
     from floodsph.scenario import load_scenario
@@ -43,10 +52,18 @@ def command(ctx: click.Context, scenario: Path, output, overwrite: bool, max_ste
         progress=not opts.get("quiet", False),
         overwrite=overwrite,
         threads=opts.get("threads"),
+        resume=resume,
     )
-    if not opts.get("quiet", False):
+    folder = output or sc.output_directory
+    status = manifest["status"]
+    if status == "interrupted":
+        click.echo(f"Interrupted at t = {manifest['sim_time_s']:g} s: {manifest['error']}. "
+                   f"Continue with: floodsph run {scenario} --resume"
+                   + (f" -o {output}" if output else ""), err=True)
+    elif not opts.get("quiet", False):
         click.echo(
-            f"{manifest['status']}: t = {manifest['sim_time_s']:g} s in {manifest['steps']} steps, "
+            f"{status}: t = {manifest['sim_time_s']:g} s in {manifest['steps']} steps, "
             f"{manifest['wall_time_s']:.1f} s wall; mass error {manifest['mass_error_rel']:.2e}; "
-            f"run folder {output or sc.output_directory}"
+            f"run folder {folder}"
         )
+    ctx.exit(EXIT_STATUS[status])

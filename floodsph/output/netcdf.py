@@ -156,15 +156,22 @@ class SnapshotWriter:
 
     The file has an unlimited ``time`` dimension (seconds since the start of the run) and
     variables ``depth`` [m], ``u`` and ``v`` [m/s] on (time, y, x), NaN where unsupported.
-    Use as a context manager or call :meth:`close`.
+    Use as a context manager or call :meth:`close`. ``keep_frames`` > 0 continues the frames
+    of an earlier file, ``source`` (default ``path`` itself; a resumed run): its first
+    ``keep_frames`` frames are copied into the new file, the frames after them (written after
+    the checkpoint) are dropped.
     """
 
     def __init__(self, path, grid, *, scenario: dict | None = None,
-                 wet_threshold: float = 0.01):
+                 wet_threshold: float = 0.01, keep_frames: int = 0, source=None):
         import netCDF4
 
         self.path = Path(path)
         self.grid = grid
+        previous = None if not keep_frames else Path(source or self.path)
+        if previous == self.path:
+            previous = self.path.with_name(self.path.name + ".previous")
+            os.replace(self.path, previous)
         ds = netCDF4.Dataset(self.path, "w", format="NETCDF4")
         ds.setncatts(global_attrs("floodsph map snapshots", scenario, wet_threshold))
         ds.createDimension("time", None)
@@ -191,6 +198,19 @@ class SnapshotWriter:
                                     chunksizes=chunks, fill_value=np.float32(np.nan))
             var.setncatts({"long_name": long_name, "units": units, "grid_mapping": "crs"})
         self._ds = ds
+        if previous is not None:
+            with netCDF4.Dataset(previous) as src:
+                for k in range(keep_frames):
+                    for name in ("time", "depth", "u", "v"):
+                        ds[name][k] = src[name][k]
+            ds.sync()
+            if source is None:
+                previous.unlink()
+
+    @property
+    def frames(self) -> int:
+        """Number of frames written."""
+        return len(self._ds.dimensions["time"])
 
     def append(self, t: float, d, u, v) -> None:
         """Add the south-up maps d [m], u, v [m/s] at time t [s]."""

@@ -1,0 +1,170 @@
+"""Checkpoint and resume (scenario-format.md, "Checkpoints and resuming a run").
+
+A run stopped by SIGTERM and resumed, any number of times, writes the same maps, gauges and
+mass balance as the run that was never stopped: bit for bit, with refinement, inflows, open
+edges and either time stepping. The stop is a real signal sent by the process to itself from
+a callback at a chosen step, so the handler, the checkpoint and the resume are the ones a
+batch scheduler's SIGTERM meets.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+
+import numpy as np
+import pytest
+import rasterio
+import xarray as xr
+from conftest import CELL, NY, X0, Y0
+
+from floodsph.output.envelopes import MAPS
+from floodsph.run import run_scenario
+from floodsph.scenario import load_scenario
+from floodsph.schedules import IterationInterval
+
+DAM_BREAK = f"""
+[scenario]
+name = "resume"
+end_time_s = 40.0
+
+[terrain]
+dem = "dem.tif"
+manning = 0.03
+edges = "open"
+
+[[initial_water]]
+level_m = 101.0
+polygon = [[{X0}, {Y0}], [{X0 + 100}, {Y0}], [{X0 + 100}, {Y0 + NY * CELL}],
+           [{X0}, {Y0 + NY * CELL}]]
+
+[[inflows]]
+line = [[{X0 + 150}, {Y0 + 50}], [{X0 + 150}, {Y0 + 150}]]
+hydrograph = "q.csv"
+direction = [1.0, 0.0]
+
+[gauges]
+file = "gauges.csv"
+interval_s = 2.0
+
+[numerics]
+particle_spacing_m = 10.0
+refinement = "split+coalesce"
+time_stepping = "{{stepping}}"
+
+[output]
+resolution_m = 10.0
+mass_balance_interval_s = 2.0
+checkpoint_interval_s = 10.0
+snapshot_interval_s = 5.0
+"""
+
+
+def sigterm_at(step: int | None):
+    """A callback that sends SIGTERM to this process once, at the first step >= ``step``."""
+    sent = []
+
+    def callback(sim):
+        if step is not None and sim.model.steps >= step and not sent:
+            sent.append(sim.model.steps)
+            os.kill(os.getpid(), signal.SIGTERM)
+
+    return callback, IterationInterval(1)
+
+
+@pytest.fixture
+def dam_break(write_scenario, tmp_path):
+    def make(stepping: str = "global", end_time: float = 40.0):
+        (tmp_path / "q.csv").write_text("time_s,discharge_m3s\n0,0\n10,20\n30,20\n40,0\n")
+        (tmp_path / "gauges.csv").write_text(
+            f"id,x,y\nbasin,{X0 + 50},{Y0 + 100}\nfloor,{X0 + 250},{Y0 + 100}\n")
+        text = DAM_BREAK.replace("{stepping}", stepping).replace(
+            "end_time_s = 40.0", f"end_time_s = {end_time}")
+        return load_scenario(write_scenario(text, name=f"{stepping}-{end_time:g}.toml"))
+
+    return make
+
+
+def run(scenario, out, stop_at=None, resume=False):
+    return run_scenario(scenario, out, progress=False, callbacks=[sigterm_at(stop_at)],
+                        resume=resume)
+
+
+def assert_same_outputs(a, b):
+    for name in MAPS:
+        with rasterio.open(a / f"{name}.tif") as x, rasterio.open(b / f"{name}.tif") as y:
+            assert np.array_equal(x.read(1), y.read(1), equal_nan=True), name
+    for table in ("gauges.csv", "mass_balance.csv"):
+        assert (a / table).read_text() == (b / table).read_text(), table
+    with xr.open_dataset(a / "flood_maps.nc") as x, xr.open_dataset(b / "flood_maps.nc") as y:
+        xr.testing.assert_identical(x.drop_attrs(), y.drop_attrs())
+    with xr.open_dataset(a / "snapshots.nc") as x, xr.open_dataset(b / "snapshots.nc") as y:
+        xr.testing.assert_identical(x.drop_attrs(), y.drop_attrs())
+
+
+@pytest.mark.parametrize("stepping", ["global", "local"])
+def test_a_run_stopped_twice_and_resumed_equals_the_uninterrupted_run(dam_break, tmp_path,
+                                                                        stepping):
+    scenario = dam_break(stepping)
+    whole = run(scenario, tmp_path / "whole")
+    assert whole["status"] == "completed"
+    assert whole["splits"] > 0 and whole["merges"] > 0  # refinement is exercised
+    assert whole["volume_in_m3"] > 0 and whole["volume_out_m3"] > 0  # inflow, open edges
+
+    first = run(scenario, tmp_path / "parts", stop_at=9)
+    assert first["status"] == "interrupted" and "SIGTERM" in first["error"]
+    assert 0 < first["steps"] < whole["steps"]
+    assert not (tmp_path / "parts" / "max_depth.tif").exists()
+    on_disk = json.loads((tmp_path / "parts" / "run.json").read_text())
+    assert on_disk["status"] == "interrupted"
+    assert on_disk["checkpoint_time_s"] == first["sim_time_s"]
+
+    second = run(scenario, tmp_path / "parts", stop_at=first["steps"] + 30, resume=True)
+    assert second["status"] == "interrupted" and second["steps"] > first["steps"]
+    last = run(scenario, tmp_path / "parts", resume=True)
+    assert last["status"] == "completed"
+    assert last["resumed_from"] == [first["sim_time_s"], second["sim_time_s"]]
+    for key in ("steps", "splits", "merges", "particles_final", "volume_in_m3",
+                "mass_error_rel"):
+        assert last[key] == whole[key], key
+    assert_same_outputs(tmp_path / "whole", tmp_path / "parts")
+
+
+def test_mass_balance_rows_written_after_the_last_checkpoint_are_not_repeated(dam_break,
+                                                                               tmp_path):
+    """A run killed (no checkpoint at the kill) resumes from its last scheduled checkpoint:
+    the rows after it are recomputed once, not appended twice."""
+    scenario = dam_break()
+    out = tmp_path / "run"
+    first = run(scenario, out, stop_at=10**9)  # completes; its last checkpoint is at 40 s
+    assert first["status"] == "completed"
+    longer = dam_break(end_time=50.0)
+    extended = run(longer, out, resume=True)
+    assert extended["status"] == "completed" and extended["sim_time_s"] == pytest.approx(50.0)
+    with open(out / "mass_balance.csv", newline="") as f:
+        times = [float(r["time_s"]) for r in csv.DictReader(f)]
+    assert times == sorted(set(times))
+    assert times[0] == 0.0 and times[-1] == pytest.approx(50.0)
+    assert extended["resumed_from"] == [pytest.approx(40.0)]
+
+
+def test_resume_refuses_a_changed_scenario_and_a_folder_without_checkpoint(dam_break,
+                                                                          tmp_path):
+    from floodsph.errors import InputError
+
+    scenario = dam_break()
+    with pytest.raises(InputError, match="no run folder to resume"):
+        run(scenario, tmp_path / "nothing", resume=True)
+    out = tmp_path / "run"
+    assert run(scenario, out, stop_at=5)["status"] == "interrupted"
+    text = scenario.path.read_text().replace("manning = 0.03", "manning = 0.04")
+    path = scenario.path.with_name("changed.toml")
+    path.write_text(text)
+    changed = load_scenario(path)
+    with pytest.raises(InputError, match=r"terrain\.manning differs"):
+        run(changed, out, resume=True)
+    # Nothing was touched by the refusal: the interrupted run resumes as it was.
+    assert json.loads((out / "run.json").read_text())["status"] == "interrupted"
+    assert run(scenario, out, resume=True)["status"] == "completed"
