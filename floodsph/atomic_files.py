@@ -28,14 +28,14 @@ def atomic_path(target: str | Path) -> Iterator[Path]:
     tmp = target.with_name(f"{TEMP_PREFIX}{target.name}")
     try:
         yield tmp
-        os.chmod(tmp, 0o666 & ~_umask())
+        os.chmod(tmp, 0o666 & ~umask())
         os.replace(tmp, target)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
 
 
-def _umask() -> int:
+def umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask

@@ -4,7 +4,7 @@
 ``(callback, schedule)`` pairs to the :class:`~floodsph.simulation.Simulation`, and writes the
 final files (:meth:`Recorders.write`) only when the run completes, so a failed or interrupted
 run never leaves maps that look finished. Snapshots are appended as the run goes to
-``snapshots.nc.part``, renamed to ``snapshots.nc`` by :meth:`Recorders.write`.
+``snapshots.nc.part``, moved to ``snapshots.nc`` by :meth:`Recorders.write`.
 :meth:`Recorders.state` and :meth:`Recorders.restore` carry everything recorded so far
 through a checkpoint.
 """
@@ -14,7 +14,6 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from floodsph.atomic_files import atomic_path
 from floodsph.run_folder import GAUGES_NAME, SNAPSHOTS_NAME
 from floodsph.scenario import Scenario
 from floodsph.schedules import TimeInterval
@@ -90,20 +89,19 @@ class Recorders:
         d, u, v, _ = rasterise(self.grid, p.x, p.y, p.u, p.v, p.m, p.rho, p.h)
         self.snapshots.append(sim.model.t, d, u, v)
 
-    def write(self) -> list[Path]:
-        """Write the maps (formats of ``output.formats``) and the gauge table; return paths."""
+    def write(self, into: Path) -> list[Path]:
+        """Write the maps (formats of ``output.formats``), the gauge table and the snapshots
+        into the folder ``into``; return their paths."""
         from floodsph.output import write_maps
 
         formats = [f.value for f in self.scenario.output.formats]
-        written = write_maps(self.envelopes, self.out, formats, scenario=self.scenario.to_dict())
+        written = write_maps(self.envelopes, into, formats, scenario=self.scenario.to_dict())
         if self.gauges is not None:
-            with atomic_path(self.out / GAUGES_NAME) as tmp:
-                self.gauges.write_csv(tmp)
-            written.append(self.out / GAUGES_NAME)
+            written.append(self.gauges.write_csv(into / GAUGES_NAME))
         if self.snapshots is not None:
             self.close()
-            os.replace(self.out / SNAPSHOTS_PART, self.out / SNAPSHOTS_NAME)
-            written.append(self.out / SNAPSHOTS_NAME)
+            os.replace(self.out / SNAPSHOTS_PART, into / SNAPSHOTS_NAME)
+            written.append(into / SNAPSHOTS_NAME)
         return written
 
     def write_pictures(self) -> list[str] | str:

@@ -18,11 +18,13 @@ replaces a completed one is built in ``.floodsph-new/`` and swapped in when it c
 from __future__ import annotations
 
 import logging
+import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from floodsph.atomic_files import atomic_path
+from floodsph.atomic_files import TEMP_PREFIX, atomic_path
+from floodsph.atomic_files import umask as _umask
 from floodsph.errors import InputError
 from floodsph.manifest import new_manifest, now_iso, write_manifest
 from floodsph.run_folder import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME, RunFolder
@@ -32,6 +34,8 @@ from floodsph.stop_signals import StopSignals
 
 log = logging.getLogger(__name__)
 
+#: ``extra`` of the records the command line reports itself, in one line (log file only).
+FILE_ONLY = {"file_only": True}
 PROGRESS_BAR_S = 0.5
 PROGRESS_LOG_S = 30.0
 
@@ -165,7 +169,8 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
                          wall_start)
             manifest["status"] = "interrupted"
             manifest["error"] = f"interrupted by {stop.requested}; checkpoint {path}"
-            log.warning("run interrupted at t = %g s: %s", model.t, manifest["error"])
+            log.warning("run interrupted at t = %g s: %s", model.t, manifest["error"],
+                        extra=FILE_ONLY)
         else:
             _write_outputs(manifest, recorders, mass, work)
             reached = model.t >= scenario.end_time_s - time_tolerance(scenario.end_time_s)
@@ -174,12 +179,14 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
     except KeyboardInterrupt as exc:
         manifest["status"] = "interrupted"
         manifest["error"] = str(exc) or "interrupted by the user (KeyboardInterrupt)"
-        log.warning("run interrupted at t = %s s", None if model is None else model.t)
+        log.warning("run interrupted at t = %s s", None if model is None else model.t,
+                    extra=FILE_ONLY)
         raise
     except BaseException as exc:
         manifest["status"] = "failed"
         manifest["error"] = error_message(exc)
-        log.error("run failed: %s", manifest["error"])
+        log.error("run failed: %s", manifest["error"], extra=FILE_ONLY)
+        folder.clear_temporaries()
         raise
     finally:
         if recorders is not None:
@@ -215,11 +222,23 @@ def _record_setup(manifest: dict, model) -> None:
 
 
 def _write_outputs(manifest: dict, recorders, mass, work: Path) -> None:
-    """Maps, gauges, snapshots, mass balance and quick-looks of a run that ended its loop."""
-    written = recorders.write()
-    with atomic_path(work / MASS_BALANCE_NAME) as tmp:
-        mass.write(tmp)
-    log.info("wrote %d map and table files", len(written) + 1)
+    """Maps, gauges, snapshots, mass balance and quick-looks of a run that ended its loop.
+
+    They are written into a temporary folder and moved into ``work`` only once all of them
+    are complete, so a failure half-way (a full disk) leaves none of them.
+    """
+    import shutil
+
+    staging = work / f"{TEMP_PREFIX}outputs"
+    shutil.rmtree(staging, ignore_errors=True)
+    staging.mkdir()
+    written = [*recorders.write(staging), mass.write(staging / MASS_BALANCE_NAME)]
+    umask = _umask()
+    for path in written:
+        os.chmod(path, 0o666 & ~umask)
+        os.replace(path, work / path.name)
+    staging.rmdir()
+    log.info("wrote %d map and table files", len(written))
     manifest["pictures"] = recorders.write_pictures()
     if isinstance(manifest["pictures"], str):
         log.warning("quick-look %s", manifest["pictures"])

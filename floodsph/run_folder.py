@@ -97,10 +97,11 @@ class RunFolder:
     def check(self) -> None:
         """Refuse a folder the run may not write: one message, nothing created or changed."""
         path = self.path
+        problem = _name_problem(path)
+        if problem:
+            raise InputError(f"{str(path)!r}: {problem}")
         if path.exists() and not path.is_dir():
             raise InputError(f"{path}: the output folder is a file; choose another --output")
-        if _name_problem(path):
-            raise InputError(f"{path}: {_name_problem(path)}")
         existing = _nearest_existing(path)
         if not os.access(existing, os.W_OK | os.X_OK):
             raise InputError(f"{existing}: not writable; choose another --output folder")
@@ -175,9 +176,17 @@ class RunFolder:
             if not self.resume:
                 shutil.rmtree(staging, ignore_errors=True)
             staging.mkdir(exist_ok=True)
-        for stale in self.work.glob(f"{TEMP_PREFIX}*"):
-            _remove(stale)
+        self.clear_temporaries()
         return self.work
+
+    def clear_temporaries(self) -> None:
+        """Remove half-written files (temporary and ``.part`` names) from ``work``; the
+        snapshots in progress stay, for a resume."""
+        for entry in self.work.iterdir():
+            name = entry.name
+            if name.startswith(TEMP_PREFIX) or (name.endswith(".part")
+                                                and name != f"{SNAPSHOTS_NAME}.part"):
+                _remove(entry)
 
     def finished_snapshots(self) -> Path | None:
         """The finished run's ``snapshots.nc`` when this run extends it from its checkpoint
@@ -249,15 +258,18 @@ def _remove(entry: Path) -> None:
 def _nearest_existing(path: Path) -> Path:
     """``path`` or its nearest existing parent."""
     path = path.absolute()
-    while not path.exists():
+    while True:
+        try:
+            if path.exists():
+                return path
+        except OSError:  # a name too long for the system, say
+            pass
         path = path.parent
-    return path
 
 
 def _name_problem(path: Path) -> str | None:
     """Why ``path`` cannot be a folder name on this system, or None."""
-    text = str(path)
-    if "\x00" in text:
+    if "\x00" in str(path):
         return "the output folder's name contains a NUL character"
     limit = os.pathconf(_nearest_existing(path), "PC_NAME_MAX")
     for part in path.parts:

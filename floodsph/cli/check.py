@@ -9,19 +9,25 @@ import click
 
 @click.command("check")
 @click.argument("scenario", type=click.Path(dir_okay=False, path_type=Path))
-def command(scenario: Path) -> None:
+@click.option("-o", "--output", type=str, default=None,
+              help="The run folder to check (default: output.directory, or out/<name>).")
+def command(scenario: Path, output) -> None:
     """Validate SCENARIO (a TOML file) without running it.
 
     Loads the scenario, the DEM and roughness, builds the initial water and seeds the
     particles, then prints the domain size, CRS, water volumes, particle count and the
     estimated peak memory. Exits with status 2 and one message on any input problem, including
-    a run whose memory estimate exceeds the memory available.
+    a run whose memory estimate exceeds the memory available, and a run folder that a run
+    could not write (a file, not writable, holding files that are not a run's).
     """
     from floodsph.inputs import prepare_inputs, summary_lines
     from floodsph.memory import available_memory, check_memory
+    from floodsph.run_folder import RunFolder
     from floodsph.scenario import load_scenario
 
     sc = load_scenario(scenario)
+    output = None if output is None else Path(output)
+    RunFolder(output or sc.output_directory, sc.input_files(), overwrite=True).check()
     inputs = prepare_inputs(sc)
     available, _ = available_memory()
     for line in summary_lines(sc, inputs, available):

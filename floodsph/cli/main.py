@@ -120,6 +120,7 @@ def _configure_logging(verbose: int, quiet: bool) -> None:
             logger.removeHandler(handler)
     handler = logging.StreamHandler()
     handler._floodsph_console = True
+    handler.addFilter(lambda record: not getattr(record, "file_only", False))
     handler.setLevel(level)
     handler.setFormatter(logging.Formatter("%(levelname)s: %(message)s"))
     logger.addHandler(handler)

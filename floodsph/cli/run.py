@@ -15,7 +15,7 @@ EXIT_STATUS = {"completed": 0, "stopped": 0, "interrupted": 130}
 @click.option(
     "-o",
     "--output",
-    type=click.Path(path_type=Path),
+    type=str,  # not click.Path: the run folder checks reach every name with one message
     default=None,
     help="Run folder (default: output.directory, or out/<name> beside the scenario).",
 )
@@ -44,6 +44,7 @@ def command(ctx: click.Context, scenario: Path, output, overwrite: bool, resume:
     from floodsph.scenario import load_scenario
 
     opts = ctx.obj or {}
+    output = None if output is None else Path(output)
     sc = load_scenario(scenario)
     manifest = run_scenario(
         sc,
