@@ -399,10 +399,16 @@ def _save(sim, scenario, threads, manifest, mass, recorders, work, wall_start) -
                             simulation=sim.state(), recorders=recorders.state(),
                             mass_rows=list(mass.rows), resumed_from=manifest["resumed_from"],
                             wall_time_s=time.monotonic() - wall_start)
+    started = time.monotonic()
     path = save_checkpoint(work, checkpoint, model.terrain)
+    seconds = time.monotonic() - started
     manifest["checkpoint_time_s"] = float(model.t)
+    manifest["checkpoint_bytes"] = path.stat().st_size
+    manifest["checkpoints_written"] = manifest.get("checkpoints_written", 0) + 1
+    manifest["checkpoint_wall_time_s"] = manifest.get("checkpoint_wall_time_s", 0.0) + seconds
     _finish_manifest(manifest, model, mass, time.monotonic() - wall_start)
-    log.info("checkpoint at t = %g s (step %d): %s", model.t, model.steps, path)
+    log.info("checkpoint at t = %g s (step %d): %s, %.1f MB in %.2f s", model.t, model.steps,
+             path, manifest["checkpoint_bytes"] / 1e6, seconds)
     return path
 
 

@@ -77,7 +77,8 @@ def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_T
 def summarise(out: Path) -> tuple[list[dict], list[dict]]:
     """Gather the sea modes run in ``out``: malpasset_points.csv, _costs.csv, particles.png.
 
-    A mode counts when its run folder holds a completed run and its report (cost.json).
+    A mode counts when its run folder holds a completed run (or one stopped by
+    ``--max-steps``) and its report (cost.json).
     """
     import csv
 
@@ -87,7 +88,7 @@ def summarise(out: Path) -> tuple[list[dict], list[dict]]:
     for sea in setup.SEA_MODES:
         cost_file = out / sea / "cost.json"
         manifest = read_manifest(out / sea / "run") or {}
-        if manifest.get("status") != "completed" or not cost_file.is_file():
+        if manifest.get("status") not in ("completed", "stopped") or not cost_file.is_file():
             continue
         costs.append(json.loads(cost_file.read_text()))
         with open(out / sea / "points.csv", newline="") as f:
