@@ -40,28 +40,31 @@ def command(ctx: click.Context, scenario: Path, output, overwrite: bool, resume:
     (Ctrl-C, SIGTERM or SIGHUP: a checkpoint is written first; exit status 130) or failed
     (exit status 1, or 2 for bad input). The maps are written only when the run completes.
     """
+    from floodsph.compile_notice import CompileNotice
     from floodsph.run import run_scenario
     from floodsph.scenario import load_scenario
 
     opts = ctx.obj or {}
+    quiet = opts.get("quiet", False)
     output = None if output is None else Path(output)
     sc = load_scenario(scenario)
-    manifest = run_scenario(
-        sc,
-        out_dir=output,
-        max_steps=max_steps,
-        progress=not opts.get("quiet", False),
-        overwrite=overwrite,
-        threads=opts.get("threads"),
-        resume=resume,
-    )
+    with CompileNotice(lambda message: None if quiet else click.echo(message, err=True)):
+        manifest = run_scenario(
+            sc,
+            out_dir=output,
+            max_steps=max_steps,
+            progress=not quiet,
+            overwrite=overwrite,
+            threads=opts.get("threads"),
+            resume=resume,
+        )
     folder = output or sc.output_directory
     status = manifest["status"]
     if status == "interrupted":
         click.echo(f"Interrupted at t = {manifest['sim_time_s']:g} s: {manifest['error']}. "
                    f"Continue with: floodsph run {scenario} --resume"
                    + (f" -o {output}" if output else ""), err=True)
-    elif not opts.get("quiet", False):
+    elif not quiet:
         click.echo(
             f"{status}: t = {manifest['sim_time_s']:g} s in {manifest['steps']} steps, "
             f"{manifest['wall_time_s']:.1f} s wall; mass error {manifest['mass_error_rel']:.2e}; "
