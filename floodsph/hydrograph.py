@@ -3,7 +3,8 @@
 The CSV format (scenario-format.md, ``[[inflows]] hydrograph``) is a header line naming at least
 the columns ``time_s`` (s) and ``discharge_m3s`` (m3/s, total through the inflow section), in any
 order, followed by one row per sample. Other columns are ignored; blank lines are skipped. Times
-must increase strictly and discharges must be finite and >= 0.
+must increase strictly and discharges must be finite, >= 0 and at most ``MAX_DISCHARGE_M3S``.
+The file is UTF-8, with or without a byte-order mark (``floodsph.io.text``).
 
 Between samples the discharge is linear in time; outside the table it is zero. The volume is
 the exact integral of that piecewise-linear function, so the volume a model injects by linear
@@ -21,9 +22,17 @@ from pathlib import Path
 import numpy as np
 
 from floodsph.errors import InputError
+from floodsph.io.text import read_csv_rows
+from floodsph.scenario_schema import LARGEST_VALUE
 
 TIME_COLUMN = "time_s"
 DISCHARGE_COLUMN = "discharge_m3s"
+
+MAX_DISCHARGE_M3S = 1.0e7
+"""The largest discharge accepted [m3/s]: about thirty times the largest river discharge ever
+gauged (the Amazon, about 3e5 m3/s), above the peak of every known dam or landslide-dam
+breach (a few 1e5 m3/s at most), of the order of the prehistoric glacial-lake outbursts. A
+value above it is a unit or typing error."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,6 +100,9 @@ def _number(text, column, name, path, line):
         _fail(name, path, line, f"{column} is NaN")
     if math.isinf(value):
         _fail(name, path, line, f"{column} = {text.strip()} is not finite")
+    if abs(value) > LARGEST_VALUE:
+        _fail(name, path, line, f"{column} = {text.strip()} is beyond +-{LARGEST_VALUE:g}, "
+                                "more than any quantity of a flood scenario in SI units")
     return value
 
 
@@ -119,17 +131,15 @@ def read_csv_columns(path, name, columns, one_of=()):
     Raises
     ------
     InputError
-        Naming the key, the file and the line: missing file, missing column (listing the
-        columns found), empty cell, non-numeric, NaN or infinite value.
+        Naming the key, the file and the line: missing file, not UTF-8, missing column
+        (listing the columns found), empty cell, non-numeric, NaN, infinite value or one
+        beyond ``LARGEST_VALUE``.
     """
     path = Path(path)
     if not path.is_file():
         _fail(name, path, None, "file not found")
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as stream:
-            rows = [(n, row) for n, row in enumerate(csv.reader(stream), start=1) if row]
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
-        _fail(name, path, None, f"cannot be read as CSV ({err})")
+    rows = [(n, row) for n, row in enumerate(read_csv_rows(path, f"{name}: {path}"), start=1)
+            if row]
     if not rows:
         _fail(name, path, None, f"is empty (expected a header with {','.join(columns)})")
     header_line, header = rows[0][0], [cell.strip() for cell in rows[0][1]]
@@ -171,8 +181,8 @@ def read_hydrograph(path, name="inflows[0].hydrograph") -> Hydrograph:
     ------
     InputError
         Naming the key, the file and (where it applies) the line: missing file, missing column,
-        non-numeric / NaN / infinite value, times not strictly increasing, negative discharge,
-        fewer than 2 data rows.
+        non-numeric / NaN / infinite value, times not strictly increasing, negative discharge
+        or one above ``MAX_DISCHARGE_M3S``, fewer than 2 data rows.
     """
     values, lines = read_csv_columns(path, name, (TIME_COLUMN, DISCHARGE_COLUMN))
     t, Q = values[TIME_COLUMN], values[DISCHARGE_COLUMN]
@@ -183,6 +193,10 @@ def read_hydrograph(path, name="inflows[0].hydrograph") -> Hydrograph:
                   "(times must increase strictly)")
         if Q[k] < 0.0:
             _fail(name, path, n, f"discharge_m3s = {Q[k]:g} is negative")
+        if Q[k] > MAX_DISCHARGE_M3S:
+            _fail(name, path, n,
+                  f"discharge_m3s = {Q[k]:g} is above {MAX_DISCHARGE_M3S:g} m3/s, more than "
+                  "any flood on record; check the units (m3/s) and the value")
     if len(lines) < 2:
         _fail(name, path, None, f"needs at least 2 data rows, found {len(lines)}")
     return Hydrograph(t, Q)

@@ -3,35 +3,46 @@
 :func:`prepare_inputs` does every step that can fail on bad input, before a run folder is
 created (``floodsph check`` stops after it and prints :func:`summary_lines`):
 
-1. load the DEM and roughness (``floodsph.io.dem.load_terrain``);
-2. check that the scenario's geometry lies on the DEM (inflow lines);
-3. build the initial depth grid: the deepest of all ``[[initial_water]]`` bodies per cell
-   (two overlapping still-water bodies hold the higher level, not the sum);
-4. seed particles on the lattice of spacing ``numerics.particle_spacing_m`` (default: the DEM
-   cell size);
-5. read or route the inflow hydrographs and integrate them up to the end time;
-6. read the gauge points (they must lie on the DEM);
-7. estimate the peak memory (``floodsph.memory``).
+1. read or route the inflow hydrographs and integrate them up to the end time;
+2. read the DEM's header and refuse a run too large for the memory available, from the grid
+   shapes alone (``floodsph.memory``), before any grid is allocated;
+3. load the DEM and roughness (``floodsph.io.dem.load_terrain``: fill values, feet, Manning
+   values that are Strickler coefficients);
+4. check that the scenario's geometry lies on the DEM (``floodsph.checks.placement``);
+5. build the initial depth grid: the deepest of all ``[[initial_water]]`` bodies per cell
+   (two overlapping still-water bodies hold the higher level, not the sum); refuse a
+   scenario without water (``floodsph.checks.water``);
+6. estimate the memory again from the wet area (particles = wet area / spacing^2) and
+   refuse before seeding; seed particles on the lattice of spacing
+   ``numerics.particle_spacing_m`` (default: the DEM cell size);
+7. read the gauge points (they must lie on the DEM);
+8. the final memory estimate from the particle count.
+
+Problems the user may mean are warnings: logged, and kept in :attr:`Inputs.warnings` (the run
+records them in ``run.json``).
 """
 
 from __future__ import annotations
 
-import logging
-import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
+from floodsph.checks.placement import check_geometry_on_dem
+from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
-from floodsph.memory import MemoryEstimate, estimate_memory, format_bytes
+from floodsph.io.raster import crs_label
+from floodsph.memory import MemoryEstimate, check_memory, estimate_memory, format_bytes
 from floodsph.scenario import Scenario
-
-log = logging.getLogger(__name__)
 
 
 @dataclass
 class Inputs:
-    """What a run starts from (all coordinates local to the terrain's origin)."""
+    """What a run starts from (all coordinates local to the terrain's origin).
+
+    ``warnings`` lists the inputs accepted with a warning (each also logged at WARNING).
+    """
 
     terrain: object
     depth: np.ndarray
@@ -44,14 +55,23 @@ class Inputs:
     volume_inflow_m3: float
     output_cells: int
     memory: MemoryEstimate
+    warnings: list[str] = field(default_factory=list)
 
 
 def prepare_inputs(scenario: Scenario) -> Inputs:
-    """Load and check everything a run needs; raises ``InputError`` on bad input."""
+    """Load and check everything a run needs; raises ``InputError`` on bad input, including a
+    run whose memory estimate exceeds the memory available (before allocating it)."""
     from floodsph.initial import seed_particles, wet_cells
     from floodsph.io.dem import load_terrain
 
     tc = scenario.terrain
+    source = str(scenario.path.name)
+    warnings: list[str] = []
+    hydrographs = inflow_hydrographs(scenario)
+    v_in = sum(float(hg.volume(0.0, scenario.end_time_s)) for hg in hydrographs)
+    read = cells_read(scenario)
+    check_memory(estimate_before_reading(scenario, v_in, read), source)
+
     terrain = load_terrain(
         tc.dem,
         crs=tc.crs,
@@ -60,30 +80,34 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         landcover=tc.landcover,
         manning_table=tc.manning_table,
         extent=tc.extent,
+        warnings=warnings,
     )
-    source = str(scenario.path.name)
-    for i, inflow in enumerate(scenario.inflows):
-        for point in inflow.line:
-            _check_on_dem(terrain, point, f"{source}: inflows[{i}].line")
-    wet = wet_cells(terrain, walled=tc.nodata_walled)
-    depth = initial_depth(scenario, terrain, wet)
     spacing = scenario.numerics.particle_spacing_m or float(min(terrain.dx, terrain.dy))
+    check_geometry_on_dem(scenario, terrain, spacing, source)
+    wet = wet_cells(terrain, walled=tc.nodata_walled)
+    dry: list[str] = []
+    depth = initial_depth(scenario, terrain, wet, dry)
+    check_has_water(scenario, dry, bool(np.any(depth > 0.0)), v_in, source, warnings)
+    out_cells = output_cells(scenario, terrain.shape, terrain.dx, terrain.dy)
+    n_wet = np.count_nonzero(depth > 0.0) * terrain.dx * terrain.dy / spacing / spacing
+    lattice = lattice_cells(terrain.width, terrain.height, spacing)
+    check_memory(_estimate(scenario, n_wet, v_in, spacing, terrain.elevation.size, out_cells,
+                           lattice, read), source)
+
     particles = seed_particles(terrain, depth, spacing, scenario.numerics.kappa, wet=wet)
-    hydrographs = inflow_hydrographs(scenario)
+    if particles.n == 0 and v_in <= 0.0:
+        raise InputError(
+            f"{source}: numerics.particle_spacing_m: the initial water seeds no particles at a "
+            f"spacing of {spacing:g} m (its depth averaged over lattice cells of that size "
+            "stays below 1 mm, or the lattice does not fit on the DEM); use a finer spacing")
     gauges = None
     if scenario.gauges is not None:
         from floodsph.output.gauges import read_gauge_file
 
         gauges = read_gauge_file(scenario.gauges.file, terrain)
-    v_in = sum(float(hg.volume(0.0, scenario.end_time_s)) for hg in hydrographs)
-    res = scenario.output.resolution_m
-    ny, nx = terrain.shape
-    out_cells = nx * ny if res is None else int(np.ceil(terrain.width / res)) * int(
-        np.ceil(terrain.height / res)
-    )
-    memory = estimate_memory(
-        particles.n, v_in, spacing, scenario.numerics.refinement.value, nx * ny, out_cells
-    )
+    memory = _estimate(scenario, particles.n, v_in, spacing, terrain.elevation.size, out_cells,
+                       lattice, read)
+    check_memory(memory, source)
     walls = [
         np.column_stack(terrain.to_local(*np.asarray(w.polyline, dtype=np.float64).T))
         for w in scenario.walls
@@ -98,30 +122,82 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         gauges=gauges,
         volume_initial_m3=particles.volume(),
         volume_inflow_m3=v_in,
-        output_cells=out_cells,
+        output_cells=int(out_cells),
         memory=memory,
+        warnings=warnings,
     )
 
 
-def _check_on_dem(terrain, point, where: str) -> None:
-    """Refuse a world point off the DEM grid or on a nodata cell."""
-    x, y = terrain.to_local(point[0], point[1])
-    col, row = int(np.floor(x / terrain.dx)), int(np.floor(y / terrain.dy))
-    ny, nx = terrain.shape
-    if not (0 <= col < nx and 0 <= row < ny):
-        xmin, ymin = terrain.x0, terrain.y0
-        extent = [xmin, ymin, xmin + terrain.width, ymin + terrain.height]
-        raise InputError(
-            f"{where}: point [{point[0]:g}, {point[1]:g}] is outside the DEM extent "
-            f"[{', '.join(f'{v:g}' for v in extent)}]"
-        )
-    if not terrain.valid[row, col]:
-        raise InputError(f"{where}: point [{point[0]:g}, {point[1]:g}] lies on DEM nodata")
+def output_cells(scenario: Scenario, shape: tuple[int, int], dx: float, dy: float) -> float:
+    """Cells of the map grid: the DEM grid, or ``output.resolution_m`` cells over it (a float:
+    a resolution far too fine gives a count beyond any integer type, even infinity)."""
+    ny, nx = shape
+    res = scenario.output.resolution_m
+    if res is None:
+        return float(nx) * float(ny)
+    with np.errstate(over="ignore"):
+        return float(np.ceil(nx * dx / res) * np.ceil(ny * dy / res))
 
 
-def initial_depth(scenario: Scenario, terrain, wet=None) -> np.ndarray:
+def lattice_cells(width: float, height: float, spacing: float) -> float:
+    """Cells of the seeding lattice of ``spacing`` over a DEM (``floodsph.initial``), a float
+    as :func:`output_cells`."""
+    nx, ny = np.floor(width / spacing + 1e-9), np.floor(height / spacing + 1e-9)
+    with np.errstate(over="ignore"):
+        return float(nx * ny)
+
+
+def _estimate(scenario, n_initial, v_in, spacing, dem_cells, out_cells, lattice,
+              read_cells=None) -> MemoryEstimate:
+    return estimate_memory(n_initial, v_in, spacing, scenario.numerics.refinement.value,
+                           dem_cells, out_cells, read_cells=read_cells, lattice_cells=lattice)
+
+
+def cells_read(scenario: Scenario) -> float:
+    """Cells of the rasters held at once while the terrain is loaded, from their headers: the
+    DEM file and the largest of the Manning, land-cover and depth rasters (each read whole)."""
+    from floodsph.io.raster import read_header
+
+    tc = scenario.terrain
+    dem = read_header(tc.dem, variable=tc.dem_variable, crs=tc.crs, what="DEM").cells
+    others = [(tc.landcover, "landcover")]
+    if isinstance(tc.manning, Path):
+        others.append((tc.manning, "manning raster"))
+    others += [(body.depth, f"initial_water[{i}].depth raster")
+               for i, body in enumerate(scenario.initial_water)]
+    largest = max((read_header(path, what=what).cells for path, what in others
+                   if path is not None), default=0)
+    return float(dem) + float(largest)
+
+
+def estimate_before_reading(scenario: Scenario, volume_inflow_m3: float,
+                            read_cells: float | None = None) -> MemoryEstimate:
+    """The memory estimate from the rasters' headers, before any raster's values are read:
+    the DEM's grids, the rasters read (``read_cells``, default :func:`cells_read`), the map
+    grids, the seeding lattice and the inflow particles (no initial particles yet: they need
+    the depth grid)."""
+    from floodsph.io.dem import check_dem_size, planned_grid
+    from floodsph.io.raster import read_header
+
+    tc = scenario.terrain
+    header = read_header(tc.dem, variable=tc.dem_variable, crs=tc.crs, what="DEM")
+    check_dem_size(header.shape, tc.dem)
+    grid = planned_grid(header, tc.extent)
+    spacing = scenario.numerics.particle_spacing_m or min(grid.dx, grid.dy)
+    return _estimate(scenario, 0.0, volume_inflow_m3, spacing, grid.cells,
+                     output_cells(scenario, (grid.rows, grid.cols), grid.dx, grid.dy),
+                     lattice_cells(grid.width, grid.height, spacing),
+                     cells_read(scenario) if read_cells is None else read_cells)
+
+
+def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None = None
+                  ) -> np.ndarray:
     """Depth grid [m] (row 0 = south) of all initial water bodies: the cell-wise maximum,
-    on the cells ``wet`` (default: the valid ones; ``floodsph.initial.wet_cells``)."""
+    on the cells ``wet`` (default: the valid ones; ``floodsph.initial.wet_cells``).
+
+    ``dry``, when a list, receives why each body that holds no water holds none
+    (:func:`floodsph.checks.water.dry_body_reason`).
+    """
     from floodsph.initial import depth_from_level, depth_from_raster
 
     source = str(scenario.path.name)
@@ -130,11 +206,14 @@ def initial_depth(scenario: Scenario, terrain, wet=None) -> np.ndarray:
         where = f"{source}: initial_water[{i}]"
         if body.depth is not None:
             d = depth_from_raster(terrain, body.depth, f"{where}.depth", wet)
+            polygon = None
         else:
             polygon = np.column_stack(
                 terrain.to_local(*np.asarray(body.polygon, dtype=np.float64).T)
             )
             d = depth_from_level(terrain, body.level_m, polygon, f"{where}.polygon", wet)
+        if dry is not None and not np.any(d > 0.0):
+            dry.append(dry_body_reason(terrain, wet, body, polygon, f"initial_water[{i}]"))
         np.maximum(depth, d, out=depth)
     return depth
 
@@ -157,18 +236,6 @@ def inflow_hydrographs(scenario: Scenario) -> list:
             t, Q, _ = breach_hydrograph(params)
             out.append(Hydrograph(t, Q))
     return out
-
-
-def crs_label(crs_wkt: str | None) -> str:
-    """``'EPSG:32632 (WGS 84 / UTM zone 32N)'`` from a WKT (name only if there is no code)."""
-    if not crs_wkt:
-        return "none (synthetic terrain)"
-    from rasterio.crs import CRS
-
-    match = re.search(r'^\s*\w+\["([^"]*)"', crs_wkt)
-    name = match.group(1) if match else "unnamed"
-    epsg = CRS.from_wkt(crs_wkt).to_epsg()
-    return f"EPSG:{epsg} ({name})" if epsg else name
 
 
 def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> list[str]:
@@ -197,4 +264,5 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"(h0 = {scenario.numerics.kappa * inputs.spacing_m:g} m)",
         f"Peak memory:     ~{format_bytes(mem.total)} (estimate, {mem.particles_peak} particles "
         f"at peak); available {avail}",
+        f"Warnings:        {len(inputs.warnings)}",
     ]

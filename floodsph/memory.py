@@ -12,18 +12,32 @@ particle spacing [m], ``D_TYPICAL`` = 1 m a typical depth of the released water,
 ``F_refinement`` the growth from splitting (4 daughters per split particle, so ``split``
 allows 4x, ``split+coalesce`` 2x since coalescing removes particles again, ``none`` 1x).
 
-Bytes::
+Bytes, at the larger of the two peaks (seeding, then the run)::
 
-    N_peak * BYTES_PER_PARTICLE + cells_out * 12 * 8 + cells_dem * 8 * 8 + BASE_BYTES
+    BASE_BYTES + DEM + max(SEEDING, N_peak * BYTES_PER_PARTICLE + OUTPUT)
 
+* DEM = (cells_dem * (DEM_GRIDS - 1) + cells_read) * 8: elevation, 5 derivative grids and
+  Manning n in float64 on the model grid, and the rasters as read (each file whole, before
+  any crop or resampling: the DEM and the largest of the Manning, land-cover and depth
+  rasters);
+* SEEDING = cells_lattice * SEEDING_ARRAYS * 8: the initial water is seeded on a dense
+  lattice of the particle spacing over the whole DEM (``floodsph.initial``): the lattice
+  depths, their padded copy, the 8 shifted neighbour grids stacked, the deepest neighbour
+  and the masks. ``tracemalloc`` measured a peak of 12.3-13.0 float64 per lattice cell
+  (lattices of 1.6e5 and 6.4e5 cells, 1 % wet); 14 errs high;
 * per particle: the 13 float64/int64 particle arrays held twice (capacity doubles when it
   grows: 208 B), ~24 float64 solver scratch arrays (192 B) and a neighbour list of ~30
   neighbours x 8 B (240 B): 640 B;
-* the output grid: ~12 float64 envelope maps (max depth, speed, ..., arrival, duration);
-* the DEM grid: elevation, 5 derivative grids, Manning n and a read buffer, float64;
+* OUTPUT = cells_out * 12 * 8: ~12 float64 envelope maps (max depth, speed, ..., arrival,
+  duration);
 * ``BASE_BYTES`` = 350 MB: the interpreter with numpy, numba, rasterio and xarray imported
   (153 MiB resident on the project machine, 183 MiB with floodsph imported: VmRSS) plus
   compiled kernels.
+
+Every count comes from shapes and areas known before the arrays exist (``floodsph.inputs``
+estimates before reading the DEM, and again before seeding), so a run too large is refused
+before it is allocated. Counts are clamped at ``COUNT_LIMIT``: a spacing of 1e-300 m gives an
+estimate that is merely enormous, not an overflow.
 """
 
 from __future__ import annotations
@@ -37,7 +51,9 @@ REFINEMENT_FACTOR = {"none": 1.0, "split": 4.0, "split+coalesce": 2.0}
 BYTES_PER_PARTICLE = 2 * 13 * 8 + 24 * 8 + 30 * 8
 OUTPUT_MAPS = 12
 DEM_GRIDS = 8
+SEEDING_ARRAYS = 14
 BASE_BYTES = 350 * 2**20
+COUNT_LIMIT = 1.0e24
 
 #: Environment variable that overrides the available memory [bytes] (used by tests).
 LIMIT_ENV = "FLOODSPH_MEMORY_LIMIT_BYTES"
@@ -52,28 +68,52 @@ class MemoryEstimate:
     output_bytes: int
     dem_bytes: int
     base_bytes: int = BASE_BYTES
+    seeding_bytes: int = 0
 
     @property
     def total(self) -> int:
-        return self.particle_bytes + self.output_bytes + self.dem_bytes + self.base_bytes
+        running = self.particle_bytes + self.output_bytes
+        return self.base_bytes + self.dem_bytes + max(self.seeding_bytes, running)
+
+    def parts_text(self) -> str:
+        """``'particles 1.2 GB, ...'``: the parts of the estimate, for messages."""
+        return (f"particles {format_bytes(self.particle_bytes)} ({self.particles_peak} at peak), "
+                f"seeding lattice {format_bytes(self.seeding_bytes)}, "
+                f"terrain grids {format_bytes(self.dem_bytes)}, "
+                f"map grids {format_bytes(self.output_bytes)}")
+
+
+def _count(x: float) -> int:
+    """A non-negative count from a float that may be huge or infinite (clamped)."""
+    return int(min(max(float(x), 0.0), COUNT_LIMIT))
 
 
 def estimate_memory(
-    n_initial: int,
+    n_initial: float,
     inflow_volume_m3: float,
     spacing_m: float,
     refinement: str,
-    dem_cells: int,
-    output_cells: int,
+    dem_cells: float,
+    output_cells: float,
+    *,
+    read_cells: float | None = None,
+    lattice_cells: float = 0.0,
 ) -> MemoryEstimate:
-    """Estimate the peak memory of a run (formula in the module docstring)."""
-    n_inflow = inflow_volume_m3 / (D_TYPICAL_M * spacing_m**2)
-    n_peak = int((n_initial + n_inflow) * REFINEMENT_FACTOR[refinement]) + 1
+    """Estimate the peak memory of a run (formula in the module docstring).
+
+    ``n_initial`` may be an estimate (wet area / spacing^2, before seeding); ``read_cells``
+    is the size of the rasters as read (default ``dem_cells``), ``lattice_cells`` that of the
+    seeding lattice.
+    """
+    n_inflow = inflow_volume_m3 / D_TYPICAL_M / spacing_m / spacing_m
+    n_peak = _count((n_initial + n_inflow) * REFINEMENT_FACTOR[refinement]) + 1
+    dem, read = _count(dem_cells), _count(dem_cells if read_cells is None else read_cells)
     return MemoryEstimate(
         particles_peak=n_peak,
         particle_bytes=n_peak * BYTES_PER_PARTICLE,
-        output_bytes=int(output_cells) * OUTPUT_MAPS * 8,
-        dem_bytes=int(dem_cells) * DEM_GRIDS * 8,
+        output_bytes=_count(output_cells) * OUTPUT_MAPS * 8,
+        dem_bytes=(dem * (DEM_GRIDS - 1) + read) * 8,
+        seeding_bytes=_count(lattice_cells) * SEEDING_ARRAYS * 8,
     )
 
 
@@ -103,9 +143,11 @@ def format_bytes(n: float) -> str:
     """``1234567`` -> ``'1.2 MB'`` (powers of 1024)."""
     for unit in ("B", "kB", "MB", "GB", "TB"):
         if abs(n) < 1024 or unit == "TB":
-            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+            break
         n /= 1024.0
-    return f"{n:.1f} TB"
+    if unit == "B":
+        return f"{n:.0f} B"
+    return f"{n:.1f} {unit}" if abs(n) < 1e5 else f"{n:.3g} {unit}"
 
 
 def check_memory(estimate: MemoryEstimate, source: str) -> None:
@@ -117,7 +159,7 @@ def check_memory(estimate: MemoryEstimate, source: str) -> None:
 
     raise InputError(
         f"{source}: the run needs an estimated {format_bytes(estimate.total)} at peak "
-        f"({estimate.particles_peak} particles) but only {format_bytes(available)} is available "
+        f"({estimate.parts_text()}) but only {format_bytes(available)} is available "
         f"({origin}); increase numerics.particle_spacing_m or output.resolution_m, or crop "
         "terrain.extent"
     )

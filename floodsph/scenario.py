@@ -17,6 +17,8 @@ from dataclasses import dataclass, field, fields
 from enum import Enum
 from pathlib import Path
 
+from floodsph.checks.elevation import ELEVATION_LIMIT_M
+from floodsph.checks.roughness import N_STRICKLER, strickler_text
 from floodsph.errors import InputError
 from floodsph.refinement import Refinement as RefinementSettings
 from floodsph.scenario_schema import Reader, describe, join
@@ -354,15 +356,37 @@ def _info(r: Reader, data: dict) -> ScenarioInfo:
         raise r.fail("scenario", "required table [scenario] is missing")
     t = r.sub_table(data, "", "scenario", ("name", "end_time_s", "description"))
     name = r.string(t, "scenario", "name")
-    if not name.strip() or name in (".", "..") or any(c in name for c in "/\\:"):
-        raise r.fail(
-            "scenario.name", f"must be a non-empty folder name without / \\ :, got {name!r}"
-        )
+    problem = name_problem(name)
+    if problem is not None:
+        raise r.fail("scenario.name", problem)
     return ScenarioInfo(
         name=name,
         end_time_s=r.number(t, "scenario", "end_time_s", gt=0.0),
         description=r.string(t, "scenario", "description", ""),
     )
+
+
+NAME_MAX_BYTES = 255
+"""The longest file or folder name most file systems allow (ext4, NTFS, APFS) [bytes]."""
+
+
+def name_problem(name: str) -> str | None:
+    """Why ``name`` cannot be the default run folder's name, or None.
+
+    It must be non-empty, not ``.`` or ``..``, free of path separators (``/ \\ :``) and
+    control characters, and at most ``NAME_MAX_BYTES`` bytes in UTF-8.
+    """
+    if not name.strip() or name in (".", ".."):
+        return f"must be a non-empty folder name, got {name!r}"
+    bad = [c for c in name if c in "/\\:" or ord(c) < 32 or ord(c) == 127]
+    if bad:
+        return (f"must be a non-empty folder name without / \\ : or control characters, got "
+                f"{describe(name)} (holds {bad[0]!r})")
+    size = len(name.encode("utf-8"))
+    if size > NAME_MAX_BYTES:
+        return (f"is {size} bytes long in UTF-8, but it names the default output folder and a "
+                f"folder name holds at most {NAME_MAX_BYTES}; shorten it")
+    return None
 
 
 def _terrain(r: Reader, data: dict) -> TerrainConfig:
@@ -376,6 +400,8 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         manning = r.file_value(manning, join(p, "manning"))
     else:
         manning = r.number(t, p, "manning", TerrainConfig.manning, gt=0.0)
+        if manning >= N_STRICKLER:
+            raise r.fail(join(p, "manning"), strickler_text(manning))
     landcover = r.existing_file(t, p, "landcover", None)
     manning_table = r.existing_file(t, p, "manning_table", None)
     if landcover is not None and "manning" in t:
@@ -435,12 +461,16 @@ def _initial_water(r: Reader, t: dict, p: str) -> InitialWater:
         raise r.fail(p, "expected level_m (with polygon) or depth")
     if "polygon" not in t:
         raise r.fail(join(p, "polygon"), "required with level_m (the area to fill)")
-    return InitialWater(level_m=r.number(t, p, "level_m"), polygon=r.polygon(t, p, "polygon"))
+    level = r.number(t, p, "level_m")
+    if abs(level) > ELEVATION_LIMIT_M:
+        raise r.fail(join(p, "level_m"), f"{level:g} m is beyond +-{ELEVATION_LIMIT_M:g} m, no "
+                                         "water surface on Earth")
+    return InitialWater(level_m=level, polygon=r.polygon(t, p, "polygon"))
 
 
 def _wall(r: Reader, t: dict, p: str) -> Wall:
     r.check_keys(t, p, ("polyline",))
-    return Wall(polyline=r.points(t, p, "polyline", at_least=2))
+    return Wall(polyline=r.polyline(t, p, "polyline"))
 
 
 def _inflow(r: Reader, t: dict, p: str) -> Inflow:
@@ -548,7 +578,7 @@ def _output(r: Reader, data: dict) -> OutputConfig:
         if len(set(formats)) != len(formats):
             raise r.fail(where, "lists a format twice")
     return OutputConfig(
-        directory=None if directory is None else r.resolve(directory),
+        directory=None if directory is None else r.resolve(directory, join(p, "directory")),
         resolution_m=r.number(t, p, "resolution_m", None, gt=0.0),
         wet_threshold_m=r.number(t, p, "wet_threshold_m", d.wet_threshold_m, ge=0.0),
         formats=formats,

@@ -16,10 +16,17 @@ from enum import Enum
 from pathlib import Path
 from typing import Any
 
+from floodsph.checks.shapes import polygon_problem, polyline_problem
 from floodsph.errors import InputError
 
 #: Marks a key without a default: absent means "missing required key".
 REQUIRED = object()
+
+LARGEST_VALUE = 1.0e12
+"""The largest magnitude any number of a scenario may have. No quantity of a flood scenario in
+SI units comes near it (projected coordinates stay below 1e8 m, the largest reservoirs hold
+2e11 m3, 1e12 s is 30,000 years), while a value beyond it (1e308) overflows to infinity in
+the first product it enters."""
 
 
 def join(path: str, key: str | int) -> str:
@@ -126,6 +133,9 @@ class Reader:
         value = float(value)
         if not math.isfinite(value):
             raise self.fail(where, f"expected a finite number, got {value}")
+        if abs(value) > LARGEST_VALUE:
+            raise self.fail(where, f"{value:g} is beyond +-{LARGEST_VALUE:g}, more than any "
+                                   "quantity of a flood scenario in SI units")
         if gt is not None and not value > gt:
             raise self.fail(where, f"must be > {gt:g}, got {value:g}")
         if ge is not None and not value >= ge:
@@ -143,6 +153,8 @@ class Reader:
         where = join(path, key)
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.fail(where, f"expected an integer, got {describe(value)}")
+        if abs(value) > LARGEST_VALUE:
+            raise self.fail(where, f"{value:g} is beyond +-{LARGEST_VALUE:g}")
         if ge is not None and value < ge:
             raise self.fail(where, f"must be >= {ge}, got {value}")
         if le is not None and value > le:
@@ -155,6 +167,8 @@ class Reader:
             return value
         if not isinstance(value, str):
             raise self.fail(join(path, key), f"expected a string, got {describe(value)}")
+        if "\0" in value:
+            raise self.fail(join(path, key), f"contains a NUL character: {value!r}")
         return value
 
     def choice(self, table: dict, path: str, key: str, enum: type[Enum], default: Enum) -> Enum:
@@ -171,8 +185,11 @@ class Reader:
         return enum(value)
 
     # -- files ----------------------------------------------------------------------------
-    def resolve(self, value: str) -> Path:
-        """``value`` as an absolute path, relative ones taken from the scenario's folder."""
+    def resolve(self, value: str, where: str = "") -> Path:
+        """``value`` as an absolute path, relative ones taken from the scenario's folder; a
+        NUL character (which no file name may hold) is refused naming ``where``."""
+        if "\0" in value:
+            raise self.fail(where, f"a path cannot contain a NUL character, got {value!r}")
         path = Path(value).expanduser()
         if not path.is_absolute():
             path = self.base_dir / path
@@ -186,7 +203,7 @@ class Reader:
         return self.file_value(value, join(path, key))
 
     def file_value(self, value: str, path: str) -> Path:
-        resolved = self.resolve(value)
+        resolved = self.resolve(value, path)
         if not resolved.exists():
             raise self.fail(path, f"file not found: {resolved}")
         if not resolved.is_file():
@@ -201,6 +218,9 @@ class Reader:
         for k, c in enumerate(value):
             if not is_number(c) or not math.isfinite(float(c)):
                 raise self.fail(join(path, k), f"expected a finite number, got {describe(c)}")
+            if abs(c) > LARGEST_VALUE:
+                raise self.fail(join(path, k), f"{c:g} is beyond +-{LARGEST_VALUE:g}, no "
+                                               "coordinate of a projected CRS")
         return float(value[0]), float(value[1])
 
     def points(
@@ -222,10 +242,19 @@ class Reader:
         return tuple(self.point(p, join(where, k)) for k, p in enumerate(value))
 
     def polygon(self, table: dict, path: str, key: str) -> tuple[tuple[float, float], ...]:
-        """A polygon: at least three points enclosing a non-zero area (shoelace formula)."""
+        """A polygon: at least three distinct points enclosing a non-zero area, its outline not
+        crossing itself (:func:`floodsph.checks.shapes.polygon_problem`)."""
         pts = self.points(table, path, key, at_least=3)
-        nxt = pts[1:] + pts[:1]
-        area = 0.5 * abs(sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(pts, nxt, strict=True)))
-        if not area > 0.0:
-            raise self.fail(join(path, key), "polygon encloses no area (its points are collinear)")
+        problem = polygon_problem(pts)
+        if problem is not None:
+            raise self.fail(join(path, key), problem)
+        return pts
+
+    def polyline(self, table: dict, path: str, key: str) -> tuple[tuple[float, float], ...]:
+        """A wall: at least two distinct points, not crossing itself; a closed one (first ==
+        last) a valid polygon (:func:`floodsph.checks.shapes.polyline_problem`)."""
+        pts = self.points(table, path, key, at_least=2)
+        problem = polyline_problem(pts)
+        if problem is not None:
+            raise self.fail(join(path, key), problem)
         return pts

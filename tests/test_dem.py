@@ -97,7 +97,7 @@ def test_netcdf_variable(tmp_path):
     xr = pytest.importorskip("xarray")
     x = 600_000.0 + 10.0 * (np.arange(12) + 0.5)
     y = 4_000_000.0 + 10.0 * (np.arange(8) + 0.5)  # increasing: stored south-up
-    elev = 50.0 + 0.5 * x[None, :] / 10.0 - 0.2 * (y[:, None] - y[0]) / 10.0
+    elev = 50.0 + 0.5 * (x[None, :] - x[0]) / 10.0 - 0.2 * (y[:, None] - y[0]) / 10.0
     crs = xr.DataArray(
         0,
         attrs={

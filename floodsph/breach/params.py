@@ -15,6 +15,7 @@ from floodsph.breach import formulas
 from floodsph.breach.storage import Storage, read_storage_table
 from floodsph.errors import InputError
 from floodsph.hydrograph import Hydrograph, read_hydrograph
+from floodsph.scenario_schema import LARGEST_VALUE
 
 #: Relative tolerance on reservoir_volume_m3 against the volume implied by the storage input.
 VOLUME_TOLERANCE = 0.01
@@ -86,6 +87,9 @@ class BreachParams:
                 value = float(value)
                 if not math.isfinite(value):
                     raise InputError(f"{where}: must be finite, got {value}")
+                if abs(value) > LARGEST_VALUE:
+                    raise InputError(f"{where}: {value:g} is beyond +-{LARGEST_VALUE:g}, more "
+                                     "than any quantity of a flood scenario in SI units")
                 if name in _POSITIVE and value <= 0.0:
                     raise InputError(f"{where}: must be > 0, got {value:g}")
             values[name] = value

@@ -3,6 +3,8 @@
 Steps (each failure is one :class:`~floodsph.errors.InputError` naming the file):
 
 1. read band 1 (GeoTIFF, ESRI ASCII ``.asc`` + ``.prj``, NetCDF variable), nodata -> NaN;
+   refuse a grid under 3 x 3 cells and undeclared fill values (:mod:`floodsph.checks.elevation`),
+   convert elevations in feet to metres;
 2. check the CRS: projected with metre units; a geographic DEM is reprojected (bilinear) to
    the UTM zone of its centre on square cells of about its native size;
 3. crop to ``extent`` (whole cells);
@@ -17,9 +19,11 @@ from __future__ import annotations
 
 import logging
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import pyproj
 from rasterio.crs import CRS
 from rasterio.enums import Resampling
 from rasterio.fill import fillnodata
@@ -27,15 +31,20 @@ from rasterio.transform import Affine
 from rasterio.warp import calculate_default_transform, reproject
 from scipy import ndimage
 
-from floodsph.errors import InputError
+from floodsph.checks.elevation import check_elevations, vertical_unit
+from floodsph.errors import InputError, warn
 from floodsph.io.manning import manning_grid
-from floodsph.io.raster import Grid, read_grid
+from floodsph.io.raster import Grid, GridHeader, read_grid
 from floodsph.terrain import Terrain
 
 log = logging.getLogger(__name__)
 
 FILL_HOLES_MAX_CELLS = 100
 """Default size [cells] of the largest interior nodata hole that is filled, not masked."""
+
+MIN_CELLS = 3
+"""Fewest rows and columns of a DEM: the bed slopes and curvatures are second-order
+differences over three cells (``floodsph.terrain``)."""
 
 
 def load_terrain(
@@ -48,6 +57,7 @@ def load_terrain(
     manning_table=None,
     extent=None,
     fill_holes_max_cells: int = FILL_HOLES_MAX_CELLS,
+    warnings: list[str] | None = None,
 ) -> Terrain:
     """Load a DEM and its roughness as a :class:`Terrain` in a local origin.
 
@@ -69,6 +79,9 @@ def load_terrain(
         touching it is kept.
     fill_holes_max_cells : int
         Interior nodata regions of at most this many cells are filled by interpolation.
+    warnings : list of str, optional
+        Receives the warnings (elevations converted from feet, a geographic DEM reprojected,
+        the file's CRS overridden; :func:`floodsph.errors.warn`).
 
     Returns
     -------
@@ -76,10 +89,12 @@ def load_terrain(
         Row 0 = south; ``x0, y0`` = world coordinates of the lower-left grid corner.
     """
     path = Path(dem_path)
-    grid = read_grid(path, variable=dem_variable, crs=crs, what="DEM")
+    grid = read_grid(path, variable=dem_variable, crs=crs, what="DEM", warnings=warnings)
     if not np.any(np.isfinite(grid.values)):
         raise InputError(f"DEM {path}: every cell is nodata")
-    grid = _ensure_projected_metres(grid, path)
+    check_dem_size(grid.shape, path)
+    grid = _elevations_in_metres(grid, path, warnings)
+    grid = _ensure_projected_metres(grid, path, warnings)
     if extent is not None:
         grid = _crop(grid, extent, path)
     elevation, valid = _fill_nodata(grid.values, fill_holes_max_cells, path)
@@ -91,6 +106,7 @@ def load_terrain(
         manning=manning,
         landcover=landcover,
         manning_table=manning_table,
+        warnings=warnings,
     )
     rows = grid.shape[0]
     t = grid.transform
@@ -106,7 +122,43 @@ def load_terrain(
     )
 
 
-def _ensure_projected_metres(grid: Grid, path: Path) -> Grid:
+def check_dem_size(shape: tuple[int, int], path) -> None:
+    """Refuse a DEM of fewer than ``MIN_CELLS`` rows or columns."""
+    rows, cols = shape
+    if rows < MIN_CELLS or cols < MIN_CELLS:
+        raise InputError(
+            f"DEM {path}: {cols} x {rows} cells (columns x rows); at least {MIN_CELLS} x "
+            f"{MIN_CELLS} are needed (the bed slope and curvature are differences over "
+            f"{MIN_CELLS} cells)")
+
+
+def _elevations_in_metres(grid: Grid, path: Path, warnings) -> Grid:
+    """Refuse undeclared fill values; convert elevations in feet (or any stated length unit
+    pyproj knows) to metres, with a warning; the result has the horizontal CRS only."""
+    unit = vertical_unit(grid.crs, grid.units)
+    factor = unit.metres
+    if factor is None:
+        warn(f"DEM {path}: the band's unit {unit.name!r} is not a length unit floodsph knows; "
+             "its values are read as metres", warnings)
+        factor = 1.0
+    check_elevations(grid.values, path, grid.nodata, factor)
+    if factor == 1.0:
+        return grid
+    warn(f"DEM {path}: elevations are in {unit.name} ({factor:.10g} m each); converted to "
+         "metres", warnings)
+    crs = horizontal_crs(grid.crs) if grid.crs is not None else None
+    return Grid(grid.values * factor, grid.transform, crs, "metre", grid.nodata)
+
+
+def horizontal_crs(crs: CRS) -> CRS:
+    """The horizontal part of a compound CRS (the CRS itself otherwise)."""
+    full = pyproj.CRS.from_wkt(crs.to_wkt())
+    if not full.is_compound:
+        return crs
+    return CRS.from_wkt(full.sub_crs_list[0].to_wkt())
+
+
+def _ensure_projected_metres(grid: Grid, path: Path, warnings=None) -> Grid:
     """Accept a projected metre CRS; reproject a geographic one to UTM; refuse the rest."""
     crs = grid.crs
     if crs is None:
@@ -115,7 +167,7 @@ def _ensure_projected_metres(grid: Grid, path: Path) -> Grid:
             '(e.g. crs = "EPSG:32632") or add a .prj file'
         )
     if crs.is_geographic:
-        return _reproject_to_utm(grid, path)
+        return _reproject_to_utm(grid, path, warnings)
     unit, factor = crs.linear_units_factor
     if not crs.is_projected or not math.isclose(factor, 1.0):
         raise InputError(
@@ -134,19 +186,76 @@ def utm_crs_for(lon: float, lat: float) -> CRS:
     return CRS.from_epsg((32600 if lat >= 0.0 else 32700) + zone)
 
 
-def _reproject_to_utm(grid: Grid, path: Path) -> Grid:
+def metric_cell_size(t: Affine, shape: tuple[int, int]) -> float:
+    """Square cell size [m] a geographic grid is reprojected to: its native cell size at its
+    central latitude on the sphere of radius 6371 km, to 3 significant digits."""
+    m_per_deg = math.pi * 6_371_000.0 / 180.0
+    lat_c = t.f + 0.5 * t.e * shape[0]
+    dx_m = abs(t.a) * m_per_deg * math.cos(math.radians(lat_c))
+    dy_m = abs(t.e) * m_per_deg
+    return float(f"{math.sqrt(dx_m * dy_m):.3g}")
+
+
+@dataclass(frozen=True)
+class PlannedGrid:
+    """The model grid :func:`load_terrain` will build: rows and columns of dx x dy [m] cells."""
+
+    rows: int
+    cols: int
+    dx: float
+    dy: float
+
+    @property
+    def cells(self) -> float:
+        return float(self.rows) * float(self.cols)
+
+    @property
+    def width(self) -> float:
+        return self.cols * self.dx
+
+    @property
+    def height(self) -> float:
+        return self.rows * self.dy
+
+
+def planned_grid(header: GridHeader, extent=None) -> PlannedGrid:
+    """The grid :func:`load_terrain` builds from a DEM, estimated from its header alone
+    (before the values are read, for the memory estimate).
+
+    A geographic grid keeps about its rows and columns on cells of :func:`metric_cell_size`
+    (its ``extent``, in the UTM CRS, is not applied: errs high); a projected one is cut to
+    the cells of ``extent``.
+    """
+    rows, cols = header.shape
+    t = header.transform
+    if header.crs is not None and header.crs.is_geographic:
+        cell = metric_cell_size(t, header.shape)
+        return PlannedGrid(rows, cols, cell, cell)
+    if extent is not None:
+        r0, r1, c0, c1 = _window(t, header.shape, extent)
+        rows, cols = max(r1 - r0, 0), max(c1 - c0, 0)
+    return PlannedGrid(rows, cols, abs(t.a), abs(t.e))
+
+
+def _window(t: Affine, shape: tuple[int, int], extent) -> tuple[int, int, int, int]:
+    """Rows r0:r1 and columns c0:c1 of a north-up grid overlapping ``extent``."""
+    xmin, ymin, xmax, ymax = (float(v) for v in extent)
+    rows, cols = shape
+    c0 = max(int(math.floor((xmin - t.c) / t.a)), 0)
+    c1 = min(int(math.ceil((xmax - t.c) / t.a)), cols)
+    r0 = max(int(math.floor((t.f - ymax) / -t.e)), 0)
+    r1 = min(int(math.ceil((t.f - ymin) / -t.e)), rows)
+    return r0, r1, c0, c1
+
+
+def _reproject_to_utm(grid: Grid, path: Path, warnings=None) -> Grid:
     """Bilinear reprojection of a geographic DEM to the UTM zone of its centre."""
     rows, cols = grid.shape
     t = grid.transform
     west, north = t.c, t.f
     east, south = west + t.a * cols, north + t.e * rows
-    lon_c, lat_c = 0.5 * (west + east), 0.5 * (south + north)
-    dst_crs = utm_crs_for(lon_c, lat_c)
-    # Native cell size in metres on the sphere of radius 6371 km, made square.
-    m_per_deg = math.pi * 6_371_000.0 / 180.0
-    dx_m = grid.dx * m_per_deg * math.cos(math.radians(lat_c))
-    dy_m = grid.dy * m_per_deg
-    cell = float(f"{math.sqrt(dx_m * dy_m):.3g}")
+    dst_crs = utm_crs_for(0.5 * (west + east), 0.5 * (south + north))
+    cell = metric_cell_size(t, grid.shape)
     dst_t, w, h = calculate_default_transform(
         grid.crs, dst_crs, cols, rows, west, south, east, north, resolution=cell
     )
@@ -163,15 +272,9 @@ def _reproject_to_utm(grid: Grid, path: Path) -> Grid:
         resampling=Resampling.bilinear,
         tolerance=0.0,  # exact transformer, not GDAL's 0.125-pixel approximation
     )
-    log.warning(
-        "DEM %s is in geographic coordinates (%s); reprojected to %s (EPSG:%d) "
-        "with %.3g m square cells",
-        path,
-        grid.crs.to_string(),
-        dst_crs.to_wkt().split('"')[1],
-        dst_crs.to_epsg(),
-        cell,
-    )
+    name = dst_crs.to_wkt().split('"')[1]
+    warn(f"DEM {path} is in geographic coordinates ({grid.crs.to_string()}); reprojected to "
+         f"{name} (EPSG:{dst_crs.to_epsg()}) with {cell:.3g} m square cells", warnings)
     return Grid(out, dst_t, dst_crs)
 
 
@@ -187,10 +290,7 @@ def _crop(grid: Grid, extent, path: Path) -> Grid:
         raise InputError(f"terrain.extent: need xmin < xmax and ymin < ymax, got {extent!r}")
     t = grid.transform
     rows, cols = grid.shape
-    c0 = max(int(math.floor((xmin - t.c) / t.a)), 0)
-    c1 = min(int(math.ceil((xmax - t.c) / t.a)), cols)
-    r0 = max(int(math.floor((t.f - ymax) / -t.e)), 0)
-    r1 = min(int(math.ceil((t.f - ymin) / -t.e)), rows)
+    r0, r1, c0, c1 = _window(t, grid.shape, extent)
     if c1 <= c0 or r1 <= r0:
         bounds = (t.c, t.f + t.e * rows, t.c + t.a * cols, t.f)
         raise InputError(

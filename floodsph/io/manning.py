@@ -9,12 +9,15 @@ Forms (flood-practice.md §1.1, as in AutoRoutePy and HydroMT mapping tables):
   table. ``manning_table = "worldcover"`` selects the table shipped with floodsph for the
   ESA WorldCover classes (``floodsph/data/worldcover_manning.csv``, textbook values).
 
-Every valid DEM cell must end up with a finite n > 0, else one InputError.
+Every valid DEM cell must end up with a finite n > 0, else one InputError; values that are
+Strickler or Chezy coefficients (n >= 1) are refused and unusually high ones (n > 0.2)
+warned of (:mod:`floodsph.checks.roughness`). Tables are UTF-8 CSV, with or without a BOM.
 """
 
 from __future__ import annotations
 
 import csv
+import io
 from importlib import resources
 from pathlib import Path
 
@@ -23,8 +26,15 @@ from rasterio.crs import CRS
 from rasterio.enums import Resampling
 from rasterio.transform import Affine
 
+from floodsph.checks.roughness import (
+    N_STRICKLER,
+    check_manning_grid,
+    check_manning_number,
+    strickler_text,
+)
 from floodsph.errors import InputError
 from floodsph.io.raster import resample_onto
+from floodsph.io.text import read_text
 
 WORLDCOVER = "worldcover"
 """Name that selects the shipped ESA WorldCover class table."""
@@ -38,14 +48,16 @@ def worldcover_table_path() -> Path:
 def read_manning_table(path) -> dict[int, float]:
     """Read a ``class,manning_n`` CSV (extra columns such as ``name`` are ignored).
 
-    Raises InputError naming the file for a missing column, a non-integer class, a
-    duplicate class or an n that is not a finite positive number.
+    Raises InputError naming the file for a file that is not UTF-8, a missing column, a
+    non-integer class, a duplicate class, an n that is not a finite positive number or one
+    that is a Strickler coefficient (n >= 1).
     """
     path = worldcover_table_path() if str(path) == WORLDCOVER else Path(path)
     if not path.is_file():
         raise InputError(f"terrain.manning_table: file not found: {path}")
     table: dict[int, float] = {}
-    with open(path, newline="") as fh:
+    text = read_text(path, f"manning table {path}")
+    with io.StringIO(text, newline="") as fh:
         reader = csv.DictReader(fh)
         fields = [f.strip() for f in (reader.fieldnames or [])]
         if "class" not in fields or "manning_n" not in fields:
@@ -62,6 +74,8 @@ def read_manning_table(path) -> dict[int, float]:
                 ) from None
             if not (np.isfinite(n) and n > 0):
                 raise InputError(f"manning table {path}, line {line}: manning_n must be > 0")
+            if n >= N_STRICKLER:
+                raise InputError(f"manning table {path}, line {line}: {strickler_text(n)}")
             if cls in table:
                 raise InputError(f"manning table {path}, line {line}: class {cls} repeated")
             table[cls] = n
@@ -79,6 +93,7 @@ def manning_grid(
     manning=0.035,
     landcover=None,
     manning_table=None,
+    warnings: list[str] | None = None,
 ) -> np.ndarray:
     """Manning's n [s m^-1/3] on a north-up DEM grid.
 
@@ -92,6 +107,8 @@ def manning_grid(
         Uniform n, or an n raster (bilinear).
     landcover, manning_table : path, optional
         Class raster (nearest) and its CSV table or ``"worldcover"``; replace ``manning``.
+    warnings : list of str, optional
+        Receives the warnings of n > 0.2 (:func:`floodsph.errors.warn`).
     """
     if landcover is not None:
         if manning_table is None:
@@ -100,6 +117,8 @@ def manning_grid(
                 '(a CSV with columns class,manning_n, or "worldcover")'
             )
         n = _from_landcover(transform, shape, crs, valid, landcover, manning_table)
+        check_manning_grid(n, valid, f"landcover {landcover} with manning table "
+                                     f"{manning_table}", warnings)
     elif isinstance(manning, (str, Path)):
         n = resample_onto(
             manning, transform, shape, crs, resampling=Resampling.bilinear, what="manning raster"
@@ -111,6 +130,7 @@ def manning_grid(
                 f"manning raster {manning}: {int(bad.sum())} DEM cells get no value or n <= 0 "
                 f"(minimum there {lo}); n must be > 0 over the whole DEM"
             )
+        check_manning_grid(n, valid, f"manning raster {manning}", warnings)
     else:
         try:
             value = float(manning)
@@ -120,6 +140,7 @@ def manning_grid(
             ) from None
         if not (np.isfinite(value) and value > 0):
             raise InputError(f"terrain.manning must be > 0, got {manning!r}")
+        check_manning_number(value, "terrain.manning", warnings)
         return np.full(shape, value, dtype=np.float64)
     fallback = float(np.median(n[valid])) if valid.any() else 0.035
     return np.where(valid, n, fallback)

@@ -7,7 +7,7 @@ returns it). Only :func:`floodsph.io.dem.load_terrain` flips to the solver's sou
 
 from __future__ import annotations
 
-import logging
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,9 +19,7 @@ from rasterio.errors import CRSError, RasterioError
 from rasterio.transform import Affine
 from rasterio.warp import reproject
 
-from floodsph.errors import InputError
-
-log = logging.getLogger(__name__)
+from floodsph.errors import InputError, warn
 
 
 @dataclass
@@ -36,11 +34,18 @@ class Grid:
         Cell (col, row) -> world (x, y) of the upper-left corner, north-up, no rotation.
     crs : CRS or None
         The raster's coordinate reference system.
+    units : str or None
+        The band's unit name as the file states it (GDAL unit type: ``"metre"``, ``"ft"``,
+        ``"US survey foot"``...), None when it states none.
+    nodata : float or None
+        The nodata value the file declares (those cells are NaN in ``values``).
     """
 
     values: np.ndarray
     transform: Affine
     crs: CRS | None
+    units: str | None = None
+    nodata: float | None = None
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -55,6 +60,19 @@ class Grid:
         return float(-self.transform.e)
 
 
+@dataclass(frozen=True)
+class GridHeader:
+    """Shape, north-up transform and CRS of a raster, read without its values."""
+
+    shape: tuple[int, int]
+    transform: Affine
+    crs: CRS | None
+
+    @property
+    def cells(self) -> int:
+        return int(self.shape[0]) * int(self.shape[1])
+
+
 def parse_crs(value, what: str) -> CRS:
     """A CRS from user input (``"EPSG:27572"``, WKT, PROJ string); InputError names ``what``."""
     try:
@@ -63,6 +81,16 @@ def parse_crs(value, what: str) -> CRS:
         raise InputError(
             f"{what}: {value!r} is not a coordinate reference system ({exc})"
         ) from None
+
+
+def crs_label(crs_wkt: str | None) -> str:
+    """``'EPSG:32632 (WGS 84 / UTM zone 32N)'`` from a WKT (name only if there is no code)."""
+    if not crs_wkt:
+        return "none (synthetic terrain)"
+    match = re.search(r'^\s*\w+\["([^"]*)"', crs_wkt)
+    name = match.group(1) if match else "unnamed"
+    epsg = CRS.from_wkt(crs_wkt).to_epsg()
+    return f"EPSG:{epsg} ({name})" if epsg else name
 
 
 def dataset_name(path: Path, variable: str | None) -> str:
@@ -83,7 +111,8 @@ def _sidecar_prj_crs(path: Path) -> CRS | None:
     return None
 
 
-def read_grid(path, *, variable: str | None = None, crs=None, what: str = "raster") -> Grid:
+def read_grid(path, *, variable: str | None = None, crs=None, what: str = "raster",
+              warnings: list[str] | None = None) -> Grid:
     """Read band 1 of a raster as a north-up float64 grid with NaN for nodata.
 
     Parameters
@@ -94,7 +123,7 @@ def read_grid(path, *, variable: str | None = None, crs=None, what: str = "raste
         NetCDF variable name (GDAL subdataset ``NETCDF:"path":variable``).
     crs : str or CRS, optional
         CRS to use when the file carries none; if the file has one and it differs, the
-        argument wins and a warning is logged.
+        argument wins and a warning is reported (into ``warnings``, :func:`floodsph.errors.warn`).
     what : str
         Role of the file in messages (``"DEM"``, ``"manning raster"``...).
 
@@ -104,40 +133,79 @@ def read_grid(path, *, variable: str | None = None, crs=None, what: str = "raste
         Missing/unreadable file, unknown NetCDF variable, rotated or sheared transform.
     """
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{what} file not found: {path}")
-    name = dataset_name(path, variable)
+    name = _dataset(path, variable, what)
     try:
         with rasterio.open(name) as src:
-            if variable is None and src.count == 0 and src.subdatasets:
-                names = [s.rsplit(":", 1)[-1] for s in src.subdatasets]
-                raise InputError(
-                    f"{what} {path}: the file holds several variables {names}; "
-                    "name one with dem_variable"
-                )
+            _refuse_container(src, path, variable, what)
             values = src.read(1, out_dtype="float64")
             nodata = src.nodata
             transform = src.transform
             file_crs = src.crs
+            units = src.units[0] or None
     except RasterioError as exc:
-        extra = f" (variable {variable!r})" if variable else ""
-        raise InputError(f"cannot read {what} {path}{extra}: {exc}") from None
+        raise _unreadable(exc, path, variable, what) from None
     if nodata is not None and not np.isnan(nodata):
         values[values == nodata] = np.nan
     values[~np.isfinite(values)] = np.nan
+    own = _own_crs(file_crs, path)
+    used = own if crs is None else parse_crs(crs, f"{what} {path}: crs")
+    if own is not None and own != used:
+        warn(f"{what} {path}: its own CRS is overridden by crs={crs}", warnings)
+    return Grid(*_north_up(values, transform, path, what), used, units, nodata)
 
+
+def read_header(path, *, variable: str | None = None, crs=None, what: str = "raster"
+                ) -> GridHeader:
+    """The shape, north-up transform and CRS of a raster, without reading its values (to
+    estimate the memory a run needs before the grid is allocated); errors as
+    :func:`read_grid`."""
+    path = Path(path)
+    name = _dataset(path, variable, what)
+    try:
+        with rasterio.open(name) as src:
+            _refuse_container(src, path, variable, what)
+            shape, transform, file_crs = src.shape, src.transform, src.crs
+    except RasterioError as exc:
+        raise _unreadable(exc, path, variable, what) from None
+    _check_axes(transform, path, what)
+    (rows, cols), t = shape, transform
+    north_up = Affine(abs(t.a), 0.0, min(t.c, t.c + t.a * cols),
+                      0.0, -abs(t.e), max(t.f, t.f + t.e * rows))
+    own = _own_crs(file_crs, path)
+    used = own if crs is None else parse_crs(crs, f"{what} {path}: crs")
+    return GridHeader((int(rows), int(cols)), north_up, used)
+
+
+def _dataset(path: Path, variable: str | None, what: str) -> str:
+    if not path.is_file():
+        raise InputError(f"{what} file not found: {path}")
+    return dataset_name(path, variable)
+
+
+def _refuse_container(src, path: Path, variable: str | None, what: str) -> None:
+    """A NetCDF file of several variables opened without naming one."""
+    if variable is None and src.count == 0 and src.subdatasets:
+        names = [s.rsplit(":", 1)[-1] for s in src.subdatasets]
+        raise InputError(
+            f"{what} {path}: the file holds several variables {names}; "
+            "name one with dem_variable"
+        )
+
+
+def _unreadable(exc: Exception, path: Path, variable: str | None, what: str) -> InputError:
+    extra = f" (variable {variable!r})" if variable else ""
+    return InputError(f"cannot read {what} {path}{extra}: {exc}")
+
+
+def _own_crs(file_crs, path: Path):
+    """The CRS the file carries (an ``.asc`` grid's from its sibling ``.prj``), or None."""
     if file_crs is None and path.suffix.lower() == ".asc":
-        file_crs = _sidecar_prj_crs(path)
-    if crs is not None:
-        user_crs = parse_crs(crs, f"{what} {path}: crs")
-        if file_crs is not None and file_crs != user_crs:
-            log.warning("%s %s: its own CRS is overridden by crs=%s", what, path, crs)
-        file_crs = user_crs
-    return Grid(*_north_up(values, transform, path, what), file_crs)
+        return _sidecar_prj_crs(path)
+    return file_crs
 
 
-def _north_up(values: np.ndarray, t: Affine, path: Path, what: str):
-    """Refuse rotation/shear; flip south-up or east-to-west rasters to north-up."""
+def _check_axes(t: Affine, path: Path, what: str) -> None:
+    """Refuse a rotated or sheared transform, or a zero cell size."""
     if t.b != 0.0 or t.d != 0.0:
         raise InputError(
             f"{what} {path}: the raster is rotated or sheared (transform {tuple(t)[:6]}); "
@@ -145,6 +213,11 @@ def _north_up(values: np.ndarray, t: Affine, path: Path, what: str):
         )
     if t.a == 0.0 or t.e == 0.0:
         raise InputError(f"{what} {path}: zero cell size in the transform {tuple(t)[:6]}")
+
+
+def _north_up(values: np.ndarray, t: Affine, path: Path, what: str):
+    """Refuse rotation/shear; flip south-up or east-to-west rasters to north-up."""
+    _check_axes(t, path, what)
     rows, cols = values.shape
     if t.e > 0:  # row 0 is the southern row
         values = values[::-1]

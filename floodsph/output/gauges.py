@@ -9,13 +9,16 @@ reports NaN for all three (GeoClaw #540: values on dry gauges give step artefact
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from floodsph.checks.placement import extent_text, lonlat_hint
 from floodsph.errors import InputError
+from floodsph.io.text import read_text
 from floodsph.output.grid import bilinear
 
 HEADER = ("time_s", "id", "depth_m", "level_m", "speed_ms")
@@ -32,17 +35,17 @@ class GaugePoints:
 
 
 def read_gauge_file(path, terrain) -> GaugePoints:
-    """Read a CSV with columns ``id, x, y`` (world coordinates in the DEM CRS).
+    """Read a UTF-8 CSV (a BOM allowed) with columns ``id, x, y`` (world coordinates in the
+    DEM CRS).
 
-    Raises InputError naming the file and line for a missing column, a non-numeric
-    coordinate, a duplicate id or a point outside the DEM.
+    Raises InputError naming the file and line for a file that is not UTF-8, a missing
+    column, a non-numeric coordinate, a duplicate id or a point outside the DEM (saying so
+    when the points look like longitude/latitude).
     """
     path = Path(path)
-    try:
-        with open(path, newline="") as f:
-            rows = list(csv.DictReader(f))
-    except OSError as e:
-        raise InputError(f"{path}: cannot read gauge file ({e.strerror})") from None
+    text = read_text(path, f"gauge file {path}")
+    with io.StringIO(text, newline="") as f:
+        rows = list(csv.DictReader(f))
     if not rows or not {"id", "x", "y"} <= set(rows[0]):
         raise InputError(f"{path}: gauge file needs the columns id, x, y")
     ids, xs, ys = [], [], []
@@ -55,7 +58,8 @@ def read_gauge_file(path, terrain) -> GaugePoints:
         lx, ly = x - terrain.x0, y - terrain.y0
         if not (0.0 <= lx <= terrain.width and 0.0 <= ly <= terrain.height):
             raise InputError(f"{path}, line {line}: gauge {row['id']!r} at ({x}, {y}) is "
-                             f"outside the DEM")
+                             f"outside the DEM extent {extent_text(terrain)}"
+                             f"{lonlat_hint([(x, y)], terrain)}")
         if row["id"] in ids:
             raise InputError(f"{path}, line {line}: duplicate gauge id {row['id']!r}")
         ids.append(row["id"])

@@ -1,0 +1,105 @@
+"""Where the scenario's geometry lies: on the DEM, in its CRS, and large enough to work.
+
+Checked once the DEM is read (:func:`check_geometry_on_dem`), each message naming the key
+path: every polygon and wall overlaps the DEM rectangle (a part outside is allowed: a
+reservoir outline drawn beyond a cropped DEM), every inflow line end lies on DEM data and the
+line is at least half a particle spacing long. Geometry given in longitude/latitude over a
+projected DEM is named as such (:func:`lonlat_hint`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+
+from floodsph.errors import InputError
+from floodsph.io.raster import crs_label
+
+INFLOW_MIN_SPACINGS = 0.5
+"""An inflow line shorter than this many particle spacings is refused: its buffer rows hold
+round(L / dx) = 0 particles, forced to one of width L, so the unit discharge Q / L and the
+boundary depth grow without bound as L shrinks (``floodsph.boundaries.inflow``)."""
+
+LONLAT_BOX = (-180.0, -90.0, 180.0, 90.0)
+"""Coordinates inside this box, over a DEM that lies outside it, are taken for degrees."""
+
+
+def dem_box(terrain) -> shapely.Polygon:
+    """The DEM rectangle in world coordinates."""
+    return shapely.box(terrain.x0, terrain.y0, terrain.x0 + terrain.width,
+                       terrain.y0 + terrain.height)
+
+
+def extent_text(terrain) -> str:
+    """``[xmin, ymin, xmax, ymax]`` of the DEM in world coordinates, for messages."""
+    x0, y0 = terrain.x0, terrain.y0
+    values = (x0, y0, x0 + terrain.width, y0 + terrain.height)
+    return "[" + ", ".join(f"{v:g}" for v in values) + "]"
+
+
+def lonlat_hint(points, terrain) -> str:
+    """A sentence for geometry that looks like longitude/latitude over a projected DEM, or ''."""
+    if not terrain.crs_wkt:
+        return ""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    xmin, ymin, xmax, ymax = LONLAT_BOX
+
+    def in_box(x, y):
+        return bool(np.all((x >= xmin) & (x <= xmax) & (y >= ymin) & (y <= ymax)))
+
+    corners = shapely.get_coordinates(dem_box(terrain))
+    if not in_box(p[:, 0], p[:, 1]) or in_box(corners[:, 0], corners[:, 1]):
+        return ""
+    return ("; its coordinates look like longitude/latitude in degrees, but they must be in "
+            f"the DEM's CRS ({crs_label(terrain.crs_wkt)}, metres)")
+
+
+def off_dem_error(where: str, what: str, points, terrain) -> InputError:
+    """``<where>: <what> outside the DEM extent [...]`` with the longitude/latitude hint."""
+    return InputError(f"{where}: {what} outside the DEM extent {extent_text(terrain)}"
+                      f"{lonlat_hint(points, terrain)}")
+
+
+def check_point_on_dem(terrain, point, where: str) -> None:
+    """Refuse a world point off the DEM grid or on a nodata cell."""
+    x, y = terrain.to_local(point[0], point[1])
+    col, row = int(np.floor(x / terrain.dx)), int(np.floor(y / terrain.dy))
+    ny, nx = terrain.shape
+    if not (0 <= col < nx and 0 <= row < ny):
+        raise off_dem_error(where, f"point [{point[0]:g}, {point[1]:g}] is", [point], terrain)
+    if not terrain.valid[row, col]:
+        raise InputError(f"{where}: point [{point[0]:g}, {point[1]:g}] lies on DEM nodata")
+
+
+def check_geometry_on_dem(scenario, terrain, spacing_m: float, source: str) -> None:
+    """Refuse polygons and walls wholly off the DEM, and inflow lines off it or too short.
+
+    A polygon must share a non-zero area with the DEM rectangle and a wall a non-zero length;
+    a part outside is allowed (a reservoir outline drawn beyond a cropped DEM).
+    """
+    box = dem_box(terrain)
+    polygons = [(f"initial_water[{i}].polygon", body.polygon)
+                for i, body in enumerate(scenario.initial_water) if body.polygon is not None]
+    polygons += [(f"sinks[{i}].polygon", sink.polygon) for i, sink in enumerate(scenario.sinks)]
+    for key, points in polygons:
+        # make_valid: a keyhole ring (allowed, floodsph.checks.shapes) is not valid for GEOS.
+        area = shapely.make_valid(shapely.Polygon(points))
+        if shapely.intersection(area, box).area <= 0.0:
+            raise off_dem_error(f"{source}: {key}", "the polygon lies wholly", points, terrain)
+    for i, wall in enumerate(scenario.walls):
+        line = shapely.LineString(wall.polyline)
+        if shapely.intersection(line, box).length <= 0.0:
+            raise off_dem_error(f"{source}: walls[{i}].polyline", "the wall lies wholly",
+                                wall.polyline, terrain)
+    for i, inflow in enumerate(scenario.inflows):
+        where = f"{source}: inflows[{i}].line"
+        for point in inflow.line:
+            check_point_on_dem(terrain, point, where)
+        length = float(np.hypot(inflow.line[1][0] - inflow.line[0][0],
+                                inflow.line[1][1] - inflow.line[0][1]))
+        if length < INFLOW_MIN_SPACINGS * spacing_m:
+            raise InputError(
+                f"{where}: the line is {length:.3g} m long, shorter than half the particle "
+                f"spacing ({INFLOW_MIN_SPACINGS * spacing_m:g} m), so the section cannot hold "
+                "one particle across; draw it across the whole breach width or lower "
+                "numerics.particle_spacing_m")
