@@ -141,7 +141,7 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
         particles_initial=inputs.particles.n,
         volume_initial_m3=inputs.volume_initial_m3,
         max_steps=opts.max_steps,
-        warnings=list(getattr(inputs, "warnings", [])),
+        warnings=list(inputs.warnings),
         resumed_from=[] if checkpoint is None else [*checkpoint.resumed_from, checkpoint.t],
         checkpoint_time_s=None if checkpoint is None else checkpoint.t,
     )

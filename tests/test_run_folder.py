@@ -295,3 +295,14 @@ def test_a_failed_run_is_not_protected_and_its_leftovers_are_cleared(scenario_fi
     assert result.exit_code == 0, result.output
     assert not (out / "max_speed.tif.part").exists() and not (out / ".tmp-run.json").exists()
     assert manifest(out)["status"] == "stopped"
+
+
+def test_input_warnings_are_recorded_in_run_json(write_scenario, tmp_path):
+    """A Manning n of 0.5 is possible (dense vegetation, debris) but suspicious: the run goes
+    on, and run.json records the warning the terminal showed."""
+    path = write_scenario(BASE_SCENARIO.replace("manning = 0.03", "manning = 0.5"))
+    result = invoke("run", path, "-o", tmp_path / "run", "--max-steps", "1")
+    assert result.exit_code == 0, result.output
+    (warning,) = manifest(tmp_path / "run")["warnings"]
+    assert "terrain.manning" in warning and "0.5" in warning
+    assert warning in result.stderr
