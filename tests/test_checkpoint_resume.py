@@ -74,15 +74,23 @@ def sigterm_at(step: int | None):
     return callback, IterationInterval(1)
 
 
+def write_dam_break(folder, stepping: str = "global", end_time: float = 40.0):
+    """The scenario file of :data:`DAM_BREAK` with its hydrograph and gauges, beside the
+    valley DEM in ``folder``."""
+    (folder / "q.csv").write_text("time_s,discharge_m3s\n0,0\n10,20\n30,20\n40,0\n")
+    (folder / "gauges.csv").write_text(
+        f"id,x,y\nbasin,{X0 + 50},{Y0 + 100}\nfloor,{X0 + 250},{Y0 + 100}\n")
+    text = DAM_BREAK.replace("{stepping}", stepping).replace(
+        "end_time_s = 40.0", f"end_time_s = {end_time}")
+    path = folder / f"{stepping}-{end_time:g}.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
 @pytest.fixture
-def dam_break(write_scenario, tmp_path):
+def dam_break(valley_dem, tmp_path):
     def make(stepping: str = "global", end_time: float = 40.0):
-        (tmp_path / "q.csv").write_text("time_s,discharge_m3s\n0,0\n10,20\n30,20\n40,0\n")
-        (tmp_path / "gauges.csv").write_text(
-            f"id,x,y\nbasin,{X0 + 50},{Y0 + 100}\nfloor,{X0 + 250},{Y0 + 100}\n")
-        text = DAM_BREAK.replace("{stepping}", stepping).replace(
-            "end_time_s = 40.0", f"end_time_s = {end_time}")
-        return load_scenario(write_scenario(text, name=f"{stepping}-{end_time:g}.toml"))
+        return load_scenario(write_dam_break(tmp_path, stepping, end_time))
 
     return make
 
