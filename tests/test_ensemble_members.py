@@ -102,3 +102,22 @@ def test_completed_means_a_completed_run_of_this_scenario(tmp_path):
     assert completed_manifest(other) is None
     (member.folder / "run.json").write_text(json.dumps({**run, "status": "failed"}))
     assert completed_manifest(member) is None
+
+
+def test_the_sample_ensemble_builds_its_members(tmp_path):
+    """data_samples/valley_breach/ensemble.toml: 32 valid members, the breach width a factor on
+    the Froehlich (2008) width of the base's 2.3 Mm3 reservoir and 9 m breach."""
+    from pathlib import Path
+
+    from floodsph.breach.formulas import froehlich2008_average_width
+
+    sample = Path(__file__).resolve().parents[1] / "data_samples" / "valley_breach"
+    members, samples = members_of(sample / "ensemble.toml", tmp_path)
+    assert len(members) == 32
+    width = froehlich2008_average_width(2.3e6, 9.0, "overtopping")
+    for member, (factor, time_factor, n) in zip(members, samples.rows, strict=True):
+        scenario = tomllib.loads(member.scenario_text)
+        breach = scenario["inflows"][0]["breach"]
+        assert breach["average_width_m"] == pytest.approx(width * factor, rel=1e-12)
+        assert breach["formation_time_s"] == pytest.approx(600.0 * time_factor, rel=1e-12)
+        assert scenario["terrain"]["manning"] == n
