@@ -38,6 +38,7 @@ COMMANDS = {
     "check": "floodsph.cli.check",
     "compare": "floodsph.cli.compare",
     "breach": "floodsph.cli.breach",
+    "ensemble": "floodsph.cli.ensemble",
 }
 """Command name -> module path; each module exposes a click command named ``command``."""
 

@@ -68,7 +68,8 @@ def grid_mapping_attrs(grid) -> dict:
     return attrs
 
 
-def _coords(grid) -> dict:
+def grid_coords(grid) -> dict:
+    """The CF ``x`` and ``y`` coordinate variables (world cell centres, y north to south)."""
     import xarray as xr
 
     xw, yw = grid.world_centres()
@@ -143,7 +144,7 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
             encoding[name] = {"dtype": "float32", "_FillValue": np.float32(np.nan),
                               "zlib": True, "complevel": 4, "chunksizes": chunks}
         data_vars[name] = xr.Variable(("y", "x"), data, attrs)
-    ds = xr.Dataset(data_vars, coords=_coords(grid),
+    ds = xr.Dataset(data_vars, coords=grid_coords(grid),
                     attrs=global_attrs(title, scenario, wet_threshold))
     part = path.with_name(path.name + ".part")
     ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)

@@ -1,4 +1,5 @@
-"""Quick-look PNGs: max depth over a hillshade, hazard classes, arrival-time contours.
+"""Quick-look PNGs: max depth over a hillshade, hazard classes, arrival-time contours, and
+an ensemble's probability map.
 
 matplotlib is optional (``floodsph[plot]``): without it every function returns the message
 ``"pictures skipped: matplotlib not installed"`` instead of paths. Figures are drawn with
@@ -116,6 +117,28 @@ def write_pictures(envelopes, out_dir, title: str = "") -> list[Path] | str:
             ax.clabel(cs, fmt="%g min", fontsize=7)
     written.append(_save(fig, out_dir / "arrival_time.png"))
     return written
+
+
+def write_probability_picture(grid, probability, path, title: str,
+                              label: str = "probability") -> Path | str:
+    """One PNG of a probability map (0..1, south-up) over the hillshade, cells of zero
+    probability left clear, with the p = 0.5 contour; or the ``SKIPPED`` message."""
+    mpl = _matplotlib()
+    if mpl is None:
+        return SKIPPED
+    Figure, colors = mpl
+    fig, ax = _axes(Figure, grid, title)
+    _hillshade(ax, colors, grid)
+    p = np.ma.masked_where(~(np.nan_to_num(probability) > 0.0), probability)
+    im = ax.imshow(p, cmap="YlOrRd", origin="lower", extent=_extent(grid), vmin=0.0, vmax=1.0,
+                   alpha=0.85, interpolation="nearest")
+    fig.colorbar(im, ax=ax, label=label, shrink=0.8)
+    filled = np.nan_to_num(probability)
+    if filled.min() < 0.5 < filled.max():
+        xc, yc = grid.world_centres()
+        ax.contour(xc / 1e3, yc[::-1] / 1e3, filled, levels=[0.5], colors="k",
+                   linewidths=0.8, linestyles="--")
+    return _save(fig, path)
 
 
 def _short(name: str) -> str:

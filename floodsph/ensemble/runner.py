@@ -1,0 +1,227 @@
+"""One ensemble from start to finish: :func:`run_ensemble` (what ``floodsph ensemble`` runs).
+
+1. Load the base scenario, draw the samples, build and check every member
+   (:mod:`floodsph.ensemble.members`): a refused value stops everything before any member runs
+   or any file is written.
+2. Check the ensemble folder: new or empty, or an earlier ensemble with ``resume`` (run only
+   the members that are missing) or ``overwrite`` (run every member again).
+3. Prepare the base scenario's inputs once: its map grid and DEM mask (the maps' common grid)
+   and its peak-memory estimate, which sizes the local cluster
+   (:func:`floodsph.ensemble.engine.plan_workers`).
+4. With ``resume``, keep the members whose folder holds a completed run of their scenario.
+5. Write the other members' folders and run them on the cluster; a member that fails is
+   recorded and the others go on.
+6. Aggregate the completed members' maps (:mod:`floodsph.ensemble.aggregate`), write them
+   (:mod:`floodsph.ensemble.outputs`), ``samples.csv`` and ``ensemble.json``.
+
+``samples.csv`` and ``ensemble.json`` are written however the ensemble ends (completed,
+failed or interrupted by Ctrl-C).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from floodsph.ensemble.manifest import (
+    ENSEMBLE_JSON,
+    final_status,
+    new_manifest,
+    read_manifest,
+    write_manifest,
+    write_samples,
+)
+from floodsph.ensemble.members import MEMBERS_DIR, MemberResult, MemberTask
+from floodsph.ensemble.spec import EnsembleSpec
+from floodsph.errors import InputError
+from floodsph.manifest import now_iso
+from floodsph.output.grid import OutputGrid
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class BaseSetup:
+    """What every member shares: the map grid, its DEM mask and a member's memory estimate."""
+
+    grid: OutputGrid
+    inside: np.ndarray
+    member_bytes: int
+
+
+def run_ensemble(spec: EnsembleSpec, out_dir: str | Path | None = None, *,
+                 workers: int | None = None, threads_per_worker: int | None = None,
+                 scheduler: str | None = None, resume: bool = False, overwrite: bool = False,
+                 progress: bool = True) -> dict:
+    """Run the ensemble ``spec`` into ``out_dir`` (default ``out/<name>`` beside the file).
+
+    Parameters
+    ----------
+    workers, threads_per_worker : int, optional
+        Local cluster size and numba threads per member (default: from the cores and the
+        members' memory estimate).
+    scheduler : str, optional
+        Address of an existing dask scheduler (``tcp://host:8786``) instead of a local
+        cluster.
+    resume : bool
+        Keep the members already completed with the same sampled scenario; run the rest.
+    overwrite : bool
+        Run every member again in an existing ensemble folder.
+    progress : bool
+        The progress bar over members (off anyway when stderr is not a terminal).
+
+    Returns the manifest (``ensemble.json``).
+
+    Raises
+    ------
+    InputError
+        A bad ensemble or base scenario, a sampled value the scenario refuses, an ensemble
+        folder that may not be used, or dask.distributed missing.
+    """
+    from floodsph.ensemble.engine import require_distributed
+    from floodsph.ensemble.members import build_members, completed_manifest
+    from floodsph.ensemble.sampling import draw_samples
+    from floodsph.scenario import load_scenario
+
+    if resume and overwrite:
+        raise InputError("--resume keeps the completed members and --overwrite runs them "
+                         "again: give one of them")
+    wall_start = time.monotonic()
+    out = Path(out_dir if out_dir is not None else spec.output_directory).resolve()
+    base = load_scenario(spec.base)
+    samples = draw_samples(spec)
+    members = build_members(spec, base, samples, out)
+    previous = _check_folder(out, resume, overwrite)
+    require_distributed()
+    setup = prepare_base(base)
+    results: dict[str, MemberResult] = {}
+    if resume:
+        for member in members:
+            kept = completed_manifest(member)
+            if kept is not None:
+                results[member.id] = MemberResult(member.id, "completed",
+                                                  kept.get("wall_time_s"))
+    to_run = [m for m in members if m.id not in results]
+    out.mkdir(parents=True, exist_ok=True)
+    manifest = new_manifest(spec.to_dict(), spec.members, scheduler)
+    manifest["members_kept"] = len(results)
+    write_manifest(out, manifest)
+    log.info("ensemble %s: %d members, %d kept from an earlier run, %d to run; folder %s",
+             spec.name, len(members), len(results), len(to_run), out)
+    try:
+        if to_run:
+            _run_members(to_run, out, manifest, results, setup, scheduler, workers,
+                         threads_per_worker, resume or overwrite, progress)
+        _write_maps(spec, base, members, results, setup, out, manifest, previous)
+    except KeyboardInterrupt:
+        manifest["status"] = "interrupted"
+        manifest["error"] = "interrupted by the user (KeyboardInterrupt)"
+        raise
+    except BaseException as exc:
+        manifest["status"] = "failed"
+        manifest["error"] = str(exc) if isinstance(exc, InputError) else (
+            f"{type(exc).__name__}: {exc}")
+        raise
+    finally:
+        manifest["members_completed"] = sum(r.status == "completed" for r in results.values())
+        manifest["members_failed"] = len(results) - manifest["members_completed"]
+        manifest["finished"] = now_iso()
+        manifest["wall_time_s"] = time.monotonic() - wall_start
+        write_samples(out, samples.keys, [m.id for m in members], samples.rows, results)
+        write_manifest(out, manifest)
+    return manifest
+
+
+def _check_folder(out: Path, resume: bool, overwrite: bool) -> dict | None:
+    """Refuse a folder the ensemble may not write; returns the earlier manifest, if any."""
+    if not out.exists():
+        return None
+    if not out.is_dir():
+        raise InputError(f"{out}: exists and is not a folder")
+    previous = read_manifest(out)
+    if previous is not None or (out / MEMBERS_DIR).exists():
+        if not (resume or overwrite):
+            raise InputError(f"{out}: already holds an ensemble ({ENSEMBLE_JSON}); pass "
+                             "--resume to run only its missing members, or --overwrite to run "
+                             "every member again")
+        return previous
+    if any(out.iterdir()):
+        raise InputError(f"{out}: is not empty and holds no ensemble; choose another output "
+                         "folder (-o)")
+    return None
+
+
+def prepare_base(base) -> BaseSetup:
+    """The base scenario's inputs: the map grid, DEM mask and memory estimate (checked)."""
+    from floodsph.ensemble.aggregate import dem_mask
+    from floodsph.inputs import prepare_inputs
+    from floodsph.memory import check_memory
+
+    inputs = prepare_inputs(base)
+    check_memory(inputs.memory, base.path.name)
+    grid = OutputGrid.from_terrain(inputs.terrain, base.output.resolution_m)
+    return BaseSetup(grid, dem_mask(inputs.terrain, grid), inputs.memory.total)
+
+
+def _run_members(to_run, out: Path, manifest, results, setup: BaseSetup, scheduler, workers,
+                 threads, replace: bool, progress: bool) -> None:
+    """Write the members' folders and run them on the cluster; results go into ``results``."""
+    from floodsph.ensemble.engine import (
+        WorkerPlan,
+        cluster_workers,
+        machine_cores,
+        open_client,
+        plan_workers,
+        run_tasks,
+    )
+    from floodsph.ensemble.members import write_member
+    from floodsph.memory import available_memory
+
+    for member in to_run:
+        write_member(member)
+    if scheduler:
+        plan = WorkerPlan(workers or 0, threads or 1)
+    else:
+        available, _ = available_memory()
+        plan = plan_workers(len(to_run), machine_cores(), setup.member_bytes, available,
+                            workers, threads)
+    with open_client(plan, scheduler) as client:
+        manifest["workers"] = cluster_workers(client)
+        manifest["threads_per_worker"] = plan.threads_per_worker
+        write_manifest(out, manifest)
+        log.info("running %d members on %d workers x %d threads (%s)", len(to_run),
+                 manifest["workers"], plan.threads_per_worker, manifest["scheduler"])
+        tasks = [MemberTask(m.id, str(m.folder), plan.threads_per_worker, replace)
+                 for m in to_run]
+        run_tasks(client, tasks, lambda r: results.__setitem__(r.id, r), progress)
+
+
+def _write_maps(spec, base, members, results, setup: BaseSetup, out: Path, manifest,
+                previous) -> None:
+    """Aggregate the completed members and write the maps; the final status."""
+    from floodsph.ensemble.aggregate import aggregate
+    from floodsph.ensemble.outputs import remove_previous, write_outputs
+
+    completed = [m.folder for m in members
+                 if m.id in results and results[m.id].status == "completed"]
+    failed = len(members) - len(completed)
+    if previous is not None:
+        pictures = previous.get("pictures")
+        remove_previous(out, [*previous.get("maps", []),
+                              *(pictures if isinstance(pictures, list) else [])])
+    if not completed:
+        manifest["status"] = "failed"
+        manifest["error"] = f"no member completed ({failed} failed; see samples.csv)"
+        return
+    maps = aggregate(completed, setup.grid, setup.inside, spec.output.depth_thresholds_m,
+                     spec.output.quantiles, out)
+    names, pictures = write_outputs(maps, setup.grid, out, ensemble=spec.to_dict(),
+                                    scenario=base.to_dict(),
+                                    wet_threshold=base.output.wet_threshold_m, title=spec.name)
+    if isinstance(pictures, str):
+        log.warning("quick-look %s", pictures)
+    manifest.update(maps=names, pictures=pictures, status=final_status(len(completed), failed))
