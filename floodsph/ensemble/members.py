@@ -291,7 +291,7 @@ class MemberResult:
 
 def run_member(task: MemberTask) -> MemberResult:
     """Run one member in its folder (on a dask worker); a failure is returned, not raised."""
-    from floodsph.run import run_scenario
+    from floodsph.run import error_message, run_scenario
     from floodsph.scenario import load_scenario
 
     start = time.monotonic()
@@ -301,7 +301,6 @@ def run_member(task: MemberTask) -> MemberResult:
         manifest = run_scenario(scenario, out_dir=folder, progress=False,
                                 overwrite=task.overwrite, threads=task.threads)
     except Exception as exc:  # recorded as the member's failure; the ensemble goes on
-        message = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
-        return MemberResult(task.id, "failed", time.monotonic() - start, message)
+        return MemberResult(task.id, "failed", time.monotonic() - start, error_message(exc))
     return MemberResult(task.id, manifest["status"], manifest.get("wall_time_s"),
                         manifest.get("error"))
