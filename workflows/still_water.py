@@ -3,26 +3,28 @@ away from the lattice: the benchmark of floodsph's wall and shore model.
 
 Each case (``still_water_cases``) is a scenario folder run through the public chain
 (``floodsph.run.run_scenario``: default numerics, closed edges, run folder and maps); a
-callback samples the particles (``sim.model.particles``) at ``SAMPLES`` report times. Still
-water: the largest and the 95th-percentile particle speed, and the level error
+callback samples the particles (``sim.model.particles``) at ``SAMPLES`` report times.
+
+Still water: the largest and the 95th-percentile particle speed, and the level error
 max |d + b - L| over the particles (d the SPH depth, b the bed under the particle, L the
-known level); in the bowl also the shore error, the largest distance of the outermost
-particle of any of ``SHORE_SECTORS`` sectors from the exact shoreline r_s. Malpasset at rest
-adds its maps: DEM cells outside the reservoir wet (``max_depth.tif`` above the scenario's
-wet threshold; the same count on the map of the particles at t = 0, which the map's kernel
-smoothing alone gives), ``max_level.tif`` over the reservoir, the ``max_speed.tif`` of the
-reservoir's cells (median, 95th percentile, max), and the splits and merges of the
-refinement (``run.json``). A case passes when every figure with a target stays within it at
-every report time after t = 0 (the issue's targets, in the tables).
+known level) and its 95th percentile; in the bowl also the shore error, the largest distance
+of the outermost particle of any of ``SHORE_SECTORS`` sectors from the exact shoreline r_s;
+for every case the splits and merges of the refinement (``run.json``: it should not start
+in still water). Malpasset at rest adds its maps: DEM cells outside the reservoir wet
+(``max_depth.tif`` above the scenario's wet threshold; the same count on the map of the
+particles at t = 0, which the map's kernel smoothing alone gives), ``max_level.tif`` over
+the reservoir, the ``max_speed.tif`` of the reservoir's cells (median, 95th percentile,
+max). A case passes when every figure with a target stays within it at every report time
+after t = 0 (the issue's targets, in the tables).
 
 The dam break: Ritter's solution (``floodsph.testing.ritter``) against the SPH depth
 interpolated (``floodsph.output.rasterise.interpolate``) on four lines along the channel
-axis at a quarter, three eighths ... of its width (12.5, 37.5, 62.5 and 87.5 m, as
+axis at 1/8, 3/8, 5/8 and 7/8 of its width (12.5, 37.5, 62.5 and 87.5 m, as
 ``floodsph.verification.ritter``), L1 relative of their mean; the two lines next to the
 walls against the two middle ones (a wall-hugging jet makes the wall lines worse: targeted
 at no more than 25 % worse); the front error (last point deeper than 0.1 m); particles
 outside the channel at any report time. Targets: the L1 of the channel turned by 30 degrees
-within 25 % of the one along x, no particle outside.
+within 25 % of the one along x (either way), no particle outside.
 
 Writes into ``--out``: the run folders, ``still_water_samples.csv`` (every report time of
 every case), ``still_water.csv`` (the table); and the report ``--doc`` (default
@@ -70,8 +72,8 @@ LINE_FRACTIONS = (0.125, 0.375, 0.625, 0.875)
 FRONT_DEPTH_M = 0.1
 PLOT_FLOOR_MS = 1e-4
 """Speeds below this [m/s] are drawn at it."""
-L1_RATIO_LIMIT = 1.25
-"""Dam break: L1 turned / L1 along x, and wall lines / middle lines, at most this."""
+ORIENTATION_TOLERANCE = 0.25
+"""Dam break: |L1 turned / L1 along x - 1| and wall lines / middle lines - 1 at most this."""
 
 
 @dataclass(frozen=True)
@@ -225,8 +227,6 @@ def reservoir_figures(run: CaseRun) -> dict:
         "max_speed_median": float(np.median(speed)),
         "max_speed_p95": float(np.percentile(speed, 95)),
         "max_speed_max": float(speed.max()),
-        "splits": int(run.manifest["splits"]),
-        "merges": int(run.manifest["merges"]),
     }
 
 
@@ -287,11 +287,11 @@ def still_checks(run: CaseRun) -> list[Check]:
 def dam_break_checks(runs: list[CaseRun]) -> list[Check]:
     """The orientation targets over the dam-break runs (the first: along x)."""
     base = runs[0].figures["l1"]
-    out = [Check(f"L1 {r.case.label} / along x", r.figures["l1"] / base, L1_RATIO_LIMIT)
-           for r in runs[1:]]
-    out += [Check(f"wall / middle lines {r.case.label}",
-                  r.figures["l1_wall_lines"] / r.figures["l1_middle_lines"], L1_RATIO_LIMIT)
-            for r in runs]
+    out = [Check(f"|L1 {r.case.label} / L1 along x - 1|", abs(r.figures["l1"] / base - 1.0),
+                 ORIENTATION_TOLERANCE) for r in runs[1:]]
+    out += [Check(f"L1 wall / middle lines - 1, {r.case.label}",
+                  r.figures["l1_wall_lines"] / r.figures["l1_middle_lines"] - 1.0,
+                  ORIENTATION_TOLERANCE) for r in runs]
     out += [Check(f"outside {r.case.label}", r.figures["outside"], 0) for r in runs]
     return out
 
@@ -327,8 +327,7 @@ def still_row(run: CaseRun) -> dict:
     if run.case.reservoir is not None:
         f = run.figures
         other = (f"cells outside wet {f['cells_outside_wet']} "
-                 f"({f['cells_outside_wet_at_0']} at 0 s); splits {f['splits']}, "
-                 f"merges {f['merges']}")
+                 f"({f['cells_outside_wet_at_0']} at 0 s)")
     return {"case": run.case.label, "particles": run.samples[0].particles,
             "end s": run.manifest["sim_time_s"],
             "max speed cm/s": 100 * run.worst("max_speed"),
@@ -336,6 +335,7 @@ def still_row(run: CaseRun) -> dict:
             "level error cm": 100 * run.worst("level_error"),
             "level error at 0 s cm": 100 * run.samples[0].level_error,
             "level p95 cm": 100 * run.worst("level_p95"),
+            "splits / merges": f"{run.manifest['splits']} / {run.manifest['merges']}",
             "other": other, "target": target_text(run.case.limits),
             "result": verdict(still_checks(run)), "wall s": run.manifest["wall_time_s"]}
 
@@ -367,8 +367,8 @@ def over_time_rows(runs: list[CaseRun], columns: int = 5) -> list[dict]:
         picks = later[len(later) // columns - 1::len(later) // columns] if later else []
         row = {"case": r.case.label}
         for k, s in enumerate(picks[:columns]):
-            row[f"t{k + 1}"] = (f"{s.t:g} s: {100 * s.max_speed:.3g} / "
-                                f"{100 * s.p95_speed:.3g}")
+            row[f"t{k + 1}"] = (f"{s.t:g} s: {readable_number(100 * s.max_speed)} / "
+                                f"{readable_number(100 * s.p95_speed)}")
         rows.append(row)
     return rows
 
@@ -445,6 +445,21 @@ def run_benchmark(args) -> Benchmark:
                      (load0, os.getloadavg()[0]), time.perf_counter() - t0)
 
 
+def readable_number(x) -> str:
+    """Three significant digits without an exponent from 0.001 up (integers as they are)."""
+    if not isinstance(x, float):
+        return str(x)
+    if x == 0.0 or not math.isfinite(x):
+        return f"{x:g}"
+    if abs(x) >= 100.0:
+        return f"{x:.0f}"
+    return f"{x:.3g}" if abs(x) >= 1e-3 else f"{x:.1e}"
+
+
+def readable(rows: list[dict]) -> list[dict]:
+    return [{k: readable_number(v) for k, v in row.items()} for row in rows]
+
+
 def tables(bench: Benchmark) -> list[str]:
     """The report's tables (markdown), each with its heading."""
     from floodsph.output.tables import markdown
@@ -454,26 +469,26 @@ def tables(bench: Benchmark) -> list[str]:
         out += ["## Still water", "",
                 "Worst value over the report times after 0 s; `level error at 0 s` is the "
                 "seeded state's.", "",
-                markdown([still_row(r) for r in bench.still], spec=".3g"), "",
+                markdown(readable([still_row(r) for r in bench.still])), "",
                 "## Speeds over time", "",
                 "max / p95 particle speed [cm/s] at five of the report times.", "",
                 markdown(over_time_rows(bench.still)), ""]
         for r in bench.still:
             if r.case.reservoir is not None:
                 f = r.figures
-                out += ["## Malpasset at rest: the maps", "", markdown([{
+                out += ["## Malpasset at rest: the maps", "", markdown(readable([{
                     "cells outside wet": f["cells_outside_wet"],
                     "of them at 0 s": f["cells_outside_wet_at_0"],
                     "max_level over the reservoir m": f["max_level_m"],
                     "max_speed median m/s": f["max_speed_median"],
                     "max_speed p95 m/s": f["max_speed_p95"],
-                    "max_speed max m/s": f["max_speed_max"],
-                    "splits": f["splits"], "merges": f["merges"]}]), ""]
+                    "max_speed max m/s": f["max_speed_max"]}])), ""]
     if bench.dam_break:
         checks = dam_break_checks(bench.dam_break)
         out += ["## Dam break along x and turned", "",
-                markdown(dam_break_rows(bench.dam_break), spec=".4g"), "",
-                markdown([{"target": c.name, "value": c.value, "limit": c.limit,
+                markdown(readable(dam_break_rows(bench.dam_break))), "",
+                markdown([{"target": c.name, "value": readable_number(c.value),
+                           "limit": c.limit,
                            "result": "pass" if c.met else "miss"} for c in checks]), ""]
     return out
 
@@ -510,7 +525,7 @@ MEASURES = (
     "* Dam break: L1 of the depth on four lines along the channel against Ritter; the lines "
     "next to the walls (12.5 and 87.5 m from them) against the two middle ones measure "
     "wall-hugging jets (target: no more than 25 % worse); particles outside the channel at "
-    "any report time.",
+    "any report time; the turned channel's L1 within 25 % of the one along x, either way.",
 )
 
 
