@@ -388,7 +388,7 @@ def build_cases(kinds, folder: Path, quick: bool, end_times: dict) -> list[cases
         elif kind == "building":
             out.append(cases.building(folder / "building", t, quick))
         elif kind == "dam-break":
-            out += [cases.dam_break(folder / f"dam-break-{a:g}", a, quick, t)
+            out += [cases.dam_break(folder / f"dam-break-{a:g}", a, t, quick)
                     for a in cases.DAM_BREAK_ANGLES]
         else:
             data = cases.mp_setup.data_folder()

@@ -272,17 +272,16 @@ def building(folder: Path, end_time: float, quick: bool) -> Case:
     return Case("building", "building 30 deg", path, LAKE_DEPTH_M, Limits(max_speed=0.01))
 
 
-def dam_break(folder: Path, angle: float, quick: bool, end_time: float | None = None) -> Case:
-    """Ritter's dam break in a channel of walls whose axis is turned by ``angle`` degrees.
+def dam_break(folder: Path, angle: float, end_time: float, quick: bool) -> Case:
+    """Ritter's dam break in a channel of walls whose axis is turned by ``angle`` degrees,
+    measured at ``end_time`` [s] (``floodsph.verification.ritter``: 50 s).
 
     The channel's upstream right-hand corner lies 50 m in from the DEM's south-west corner
     (at 30 degrees, 50 m in from the west and ``width sin 30`` higher, so the turned
     channel fits); the 10 m DEM cells and the particle lattice share the DEM's origin, so
     the walls of the channel along x lie on lattice cell edges.
     """
-    length, t_end = (600.0, 12.0) if quick else (2000.0, 50.0)
-    if end_time is not None:
-        t_end = end_time
+    length, t_end = (600.0 if quick else 2000.0), end_time
     width, d0, spacing, margin = 100.0, 10.0, 10.0, 50.0
     t = math.radians(angle)
     x0 = ORIGIN[0] + margin + width * math.sin(t)
