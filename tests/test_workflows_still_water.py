@@ -44,6 +44,11 @@ def test_the_quick_benchmark_has_one_row_per_case_and_angle_in_its_table_csv_and
     for label in STILL_ROWS + DAM_BREAK_ROWS:
         assert f"| {label} |" in doc
     assert "python workflows/still_water.py --quick" in doc
+    tables = [b for b in doc.split("\n\n") if b.startswith("| ")]
+    assert len(tables) == 4  # still water, over time, dam break, its targets
+    for table in tables:
+        lines = table.splitlines()
+        assert all(line.count("|") == lines[0].count("|") for line in lines), table
     assert "max < 1 cm/s" in doc and "shore within 5 m" in doc
     assert (out / "doc.png").stat().st_size > 0
 
@@ -110,6 +115,10 @@ def test_the_dam_break_keeps_its_water_in_the_channel_and_follows_ritter_at_both
         assert run.figures["outside"] == 0
         assert 0.0 < run.figures["l1"] < 0.05
     assert runs[1].figures["l1"] == pytest.approx(runs[0].figures["l1"], rel=0.25)
+    checks = still.dam_break_checks(runs)
+    assert [c.met for c in checks] == [True] * 5
+    too_far = still.Check("L1 ratio - 1", -0.3, 0.25, two_sided=True)
+    assert not too_far.met and too_far.limit_text == "+/- 0.25"
 
 
 def test_shore_error_is_the_worst_sector_of_the_outermost_particles():
