@@ -181,3 +181,16 @@ def test_resume_runs_the_failed_members_again(case, samples, resumed):
         if row["status"] == "failed":
             assert again[row["member"]]["status"] == "failed"
             assert again[row["member"]]["wall_time_s"] != row["wall_time_s"]
+
+
+def test_local_workers_get_their_threads_and_keep_glibc_adaptive():
+    """Workers start with NUMBA_NUM_THREADS = the threads per worker, and without dask's
+    MALLOC_TRIM_THRESHOLD_ (floodsph.ensemble.engine.MALLOC_TRIM_KEY)."""
+    import os
+
+    from floodsph.ensemble.engine import WorkerPlan, open_client
+
+    names = ("NUMBA_NUM_THREADS", "MALLOC_TRIM_THRESHOLD_")
+    with open_client(WorkerPlan(1, 2), None) as client:
+        env = client.submit(lambda: {k: os.environ.get(k) for k in names}, pure=False).result()
+    assert env == {"NUMBA_NUM_THREADS": "2", "MALLOC_TRIM_THRESHOLD_": None}

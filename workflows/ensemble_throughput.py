@@ -6,9 +6,10 @@ K members (``--members``, default 8) of the ensemble file (default
 1. as ensembles (``floodsph.ensemble.runner.run_ensemble``, a fresh local cluster each) with
    1 worker x 2 threads and with 2 workers x 1 thread: the wall time from start to finish
    (ensemble.json ``wall_time_s``) gives ``members_per_hour`` = K / wall x 3600;
-2. alone: each member's ``scenario.toml`` through ``floodsph.run.run_scenario`` in this
-   process, with 2 threads and with 1 thread, after one untimed warm-up run (the compiled
-   kernels loaded from numba's cache): ``member_alone_s`` is their mean.
+2. alone, right after each ensemble: each member's ``scenario.toml`` through
+   ``floodsph.run.run_scenario`` in this process with the configuration's threads (after one
+   untimed warm-up run, the compiled kernels loaded from numba's cache):
+   ``member_alone_s`` is their mean.
 
 For each configuration, with W workers, ``ideal_s`` = (sum of the members' alone times at the
 configuration's threads) / W is the wall of the members back to back with nothing else, and
@@ -104,34 +105,37 @@ def fixed_times(spec, base, folder: Path, members: list[Path], workers: int,
 
 
 def measure(ensemble: Path, members: int, out: Path) -> list[dict]:
-    """The table rows, one per configuration (module docstring)."""
+    """The table rows, one per configuration (module docstring).
+
+    Each configuration's alone runs follow its ensemble at once, so that both meet the same
+    load on a shared machine.
+    """
     from floodsph.ensemble.runner import run_ensemble
     from floodsph.ensemble.spec import load_ensemble
     from floodsph.scenario import load_scenario
 
     spec = replace(load_ensemble(ensemble), members=members)
     base = load_scenario(spec.base)
-    manifests = {}
-    for workers, threads in CONFIGS:
-        folder = out / f"w{workers}x{threads}"
-        if folder.exists():
-            shutil.rmtree(folder)
-        manifests[workers, threads] = run_ensemble(spec, folder, workers=workers,
-                                                   threads_per_worker=threads, progress=True)
-        print(f"{workers} x {threads}: {manifests[workers, threads]['wall_time_s']:.1f} s",
-              flush=True)
-    member_folders = sorted((out / "w1x2" / "members").iterdir())
     rows = []
     with tempfile.TemporaryDirectory(prefix="alone-", dir=out) as tmp:
         scratch = Path(tmp)
-        alone_times(member_folders[:1], 2, scratch / "warm-up")
-        alone = {t: alone_times(member_folders, t, scratch) for t in {t for _, t in CONFIGS}}
-        for (workers, threads), manifest in manifests.items():
+        for k, (workers, threads) in enumerate(CONFIGS):
+            folder = out / f"w{workers}x{threads}"
+            if folder.exists():
+                shutil.rmtree(folder)
+            manifest = run_ensemble(spec, folder, workers=workers, threads_per_worker=threads,
+                                    progress=True)
             wall = float(manifest["wall_time_s"])
-            mean = statistics.fmean(alone[threads])
-            ideal = sum(alone[threads]) / workers
+            member_folders = sorted((folder / "members").iterdir())
+            if k == 0:
+                alone_times(member_folders[:1], threads, scratch / "warm-up")
+            alone = alone_times(member_folders, threads, scratch)
+            mean = statistics.fmean(alone)
+            ideal = sum(alone) / workers
             fixed = fixed_times(spec, base, scratch / f"check-{workers}", member_folders,
                                 workers, scratch)
+            print(f"{workers} x {threads}: ensemble {wall:.1f} s, members alone "
+                  f"{sum(alone):.1f} s", flush=True)
             rows.append({
                 "workers": workers, "threads": threads, "members": members, "wall_s": wall,
                 "members_per_hour": members / wall * 3600.0, "member_alone_s": mean,

@@ -12,6 +12,7 @@
 ``rasters``        a raster scaled by a factor into a member's folder
 ``engine``         the dask.distributed cluster: sizing, submission, progress
 ``aggregate``      streamed exceedance-probability and quantile maps over the members
+``outputs``        the map files: COG GeoTIFFs, ``ensemble_maps.nc``, ``ensemble.png``
 ``netcdf``         the ``ensemble_maps.nc`` writer
 ``manifest``       ``ensemble.json`` and ``samples.csv``
 ``runner``         the whole ensemble, start to finish (:func:`run_ensemble`)

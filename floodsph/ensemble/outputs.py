@@ -18,7 +18,10 @@ NaN nodata).
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from floodsph.ensemble.aggregate import UK_CLASSES, EnsembleMaps
 from floodsph.ensemble.spec import quantile_label, threshold_label
@@ -36,26 +39,43 @@ QUANTILE_MAPS = {
 }
 
 
-def geotiff_layers(maps: EnsembleMaps) -> list[tuple[str, object, str, str]]:
-    """``(file name, south-up map, units, long name)`` of every GeoTIFF, in writing order."""
+@dataclass(frozen=True)
+class Layer:
+    """One GeoTIFF: its file name, south-up map, units and long name."""
+
+    file_name: str
+    data: np.ndarray
+    units: str
+    long_name: str
+
+
+def geotiff_layers(maps: EnsembleMaps) -> list[Layer]:
+    """Every GeoTIFF of the ensemble maps, in writing order."""
     out = []
     for k, t in enumerate(maps.thresholds):
-        out.append((f"p_depth_gt_{threshold_label(t)}m.tif", maps.p_depth_gt[k], "1",
-                    f"probability that the maximum depth exceeds {t:g} m"))
+        out.append(Layer(f"p_depth_gt_{threshold_label(t)}m.tif", maps.p_depth_gt[k], "1",
+                         f"probability that the maximum depth exceeds {t:g} m"))
     for attr, (stem, long_name, units) in QUANTILE_MAPS.items():
         for k, q in enumerate(maps.quantiles):
-            out.append((f"{stem}_{quantile_label(q)}.tif", getattr(maps, attr)[k], units,
-                        f"{long_name}, {q:g} quantile over the members"))
+            out.append(Layer(f"{stem}_{quantile_label(q)}.tif", getattr(maps, attr)[k], units,
+                             f"{long_name}, {q:g} quantile over the members"))
     for k, cls in enumerate(UK_CLASSES):
-        out.append((f"p_hazard_uk_ge_{cls}.tif", maps.p_hazard_uk_ge[k], "1",
-                    f"probability of UK hazard rating class {cls} or worse"))
+        out.append(Layer(f"p_hazard_uk_ge_{cls}.tif", maps.p_hazard_uk_ge[k], "1",
+                         f"probability of UK hazard rating class {cls} or worse"))
     return out
 
 
+@dataclass(frozen=True)
+class Written:
+    """The files written: map file names, and the picture's name (or why it was skipped)."""
+
+    maps: list[str]
+    pictures: list[str] | str
+
+
 def write_outputs(maps: EnsembleMaps, grid, out: Path, *, ensemble: dict, scenario: dict,
-                  wet_threshold: float, title: str) -> tuple[list[str], list[str] | str]:
-    """Write every map file into ``out``; returns (map file names, picture names or the
-    message why the picture was skipped)."""
+                  wet_threshold: float, title: str) -> Written:
+    """Write every map file into ``out``."""
     from floodsph._version import __version__
     from floodsph.ensemble.netcdf import write_ensemble_netcdf
     from floodsph.output.geotiff import write_geotiff
@@ -64,10 +84,11 @@ def write_outputs(maps: EnsembleMaps, grid, out: Path, *, ensemble: dict, scenar
     tags = {"members_completed": maps.members, "ensemble": ensemble["name"],
             "wet_threshold_m": wet_threshold, "source": f"floodsph {__version__}"}
     names = []
-    for name, array, units, long_name in geotiff_layers(maps):
-        write_geotiff(out / name, array, grid, name.removesuffix(".tif"), units,
-                      long_name=long_name, tags=tags)
-        names.append(name)
+    for layer in geotiff_layers(maps):
+        write_geotiff(out / layer.file_name, layer.data, grid,
+                      layer.file_name.removesuffix(".tif"), layer.units,
+                      long_name=layer.long_name, tags=tags)
+        names.append(layer.file_name)
     write_ensemble_netcdf(out / NETCDF_NAME, maps, grid, ensemble=ensemble, scenario=scenario,
                           wet_threshold=wet_threshold)
     names.append(NETCDF_NAME)
@@ -78,8 +99,7 @@ def write_outputs(maps: EnsembleMaps, grid, out: Path, *, ensemble: dict, scenar
         grid, maps.p_depth_gt[k], out / PICTURE_NAME,
         f"{title}: P(max depth > {t:g} m) over {maps.members} members",
         label=f"probability that the maximum depth exceeds {t:g} m")
-    pictures = picture if isinstance(picture, str) else [Path(picture).name]
-    return names, pictures
+    return Written(names, picture if isinstance(picture, str) else [Path(picture).name])
 
 
 def remove_previous(out: Path, names) -> None:

@@ -219,9 +219,10 @@ def _write_maps(spec, base, members, results, setup: BaseSetup, out: Path, manif
         return
     maps = aggregate(completed, setup.grid, setup.inside, spec.output.depth_thresholds_m,
                      spec.output.quantiles, out)
-    names, pictures = write_outputs(maps, setup.grid, out, ensemble=spec.to_dict(),
-                                    scenario=base.to_dict(),
-                                    wet_threshold=base.output.wet_threshold_m, title=spec.name)
-    if isinstance(pictures, str):
-        log.warning("quick-look %s", pictures)
-    manifest.update(maps=names, pictures=pictures, status=final_status(len(completed), failed))
+    written = write_outputs(maps, setup.grid, out, ensemble=spec.to_dict(),
+                            scenario=base.to_dict(), wet_threshold=base.output.wet_threshold_m,
+                            title=spec.name)
+    if isinstance(written.pictures, str):
+        log.warning("quick-look %s", written.pictures)
+    manifest.update(maps=written.maps, pictures=written.pictures,
+                    status=final_status(len(completed), failed))
