@@ -183,14 +183,18 @@ def test_resume_runs_the_failed_members_again(case, samples, resumed):
             assert again[row["member"]]["wall_time_s"] != row["wall_time_s"]
 
 
-def test_local_workers_get_their_threads_and_keep_glibc_adaptive():
-    """Workers start with NUMBA_NUM_THREADS = the threads per worker, and without dask's
-    MALLOC_TRIM_THRESHOLD_ (floodsph.ensemble.engine.MALLOC_TRIM_KEY)."""
+def test_local_workers_get_their_threads_no_malloc_trim_and_no_profiler():
+    """Workers start with NUMBA_NUM_THREADS = the threads per worker, without dask's
+    MALLOC_TRIM_THRESHOLD_ and with the profiler off (floodsph.ensemble.engine)."""
     import os
+
+    import dask
 
     from floodsph.ensemble.engine import WorkerPlan, open_client
 
     names = ("NUMBA_NUM_THREADS", "MALLOC_TRIM_THRESHOLD_")
     with open_client(WorkerPlan(1, 2), None) as client:
         env = client.submit(lambda: {k: os.environ.get(k) for k in names}, pure=False).result()
+        profile = client.run(lambda: dask.config.get("distributed.worker.profile.enabled"))
     assert env == {"NUMBA_NUM_THREADS": "2", "MALLOC_TRIM_THRESHOLD_": None}
+    assert list(profile.values()) == [False]

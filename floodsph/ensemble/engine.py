@@ -37,6 +37,9 @@ INSTALL_HINT = ("floodsph ensemble needs dask.distributed, which is not installe
 #: A member per worker frees its memory when it ends anyway, so the local cluster's workers
 #: start without it (None unsets a variable there; one in the user's environment still wins).
 MALLOC_TRIM_KEY = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
+#: dask's statistical profiler samples every worker thread's stack every 10 ms for the
+#: dashboard, which the local cluster does not start; off, it takes no GIL from the members.
+PROFILE_KEY = "distributed.worker.profile.enabled"
 
 
 def require_distributed() -> None:
@@ -101,7 +104,7 @@ def open_client(plan: WorkerPlan, scheduler: str | None):
     import dask
 
     threads = str(plan.threads_per_worker)
-    with dask.config.set({MALLOC_TRIM_KEY: None}):
+    with dask.config.set({MALLOC_TRIM_KEY: None, PROFILE_KEY: False}):
         cluster = LocalCluster(n_workers=plan.workers, threads_per_worker=1, processes=True,
                                host="127.0.0.1", dashboard_address=None,
                                silence_logs=logging.ERROR,
