@@ -165,3 +165,22 @@ def test_cluster_size_from_cores_and_memory(args, plan):
 def test_cluster_size_with_threads_or_workers_given():
     assert plan_workers(32, 8, 10**9, 10**11, threads=2).workers == 4
     assert plan_workers(32, 8, 10**9, 10**11, workers=3).threads_per_worker == 2
+
+
+def test_map_files_and_no_picture_without_matplotlib(result, tmp_path, monkeypatch):
+    """The contract's file names; without matplotlib the picture is skipped, saying why."""
+    from floodsph.ensemble.outputs import write_outputs
+    from floodsph.output import pictures
+
+    monkeypatch.setattr(pictures, "_matplotlib", lambda: None)
+    out = tmp_path / "maps"
+    out.mkdir()
+    written = write_outputs(result, grid(), out, ensemble={"name": "e"}, scenario={},
+                            wet_threshold=0.01, title="e")
+    assert written.pictures == "pictures skipped: matplotlib not installed"
+    assert sorted(written.maps) == sorted(p.name for p in out.iterdir())
+    assert set(written.maps) == {
+        "p_depth_gt_0.1m.tif", "p_depth_gt_0.5m.tif",
+        *(f"{m}_{q}.tif" for m in ("max_depth", "max_speed", "arrival_time")
+          for q in ("q05", "q50", "q95")),
+        *(f"p_hazard_uk_ge_{k}.tif" for k in (1, 2, 3, 4)), "ensemble_maps.nc"}

@@ -185,7 +185,7 @@ def test_resume_runs_the_failed_members_again(case, samples, resumed):
 
 def test_local_workers_get_their_threads_no_malloc_trim_and_no_profiler():
     """Workers start with NUMBA_NUM_THREADS = the threads per worker, without dask's
-    MALLOC_TRIM_THRESHOLD_ and with the profiler off (floodsph.ensemble.engine)."""
+    MALLOC_TRIM_THRESHOLD_ and with the profiler off (floodsph.ensemble.engine.CLUSTER_CONFIG)."""
     import os
 
     import dask
