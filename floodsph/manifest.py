@@ -60,14 +60,14 @@ def new_manifest(scenario_dict: dict) -> dict:
     }
 
 
-def _json_safe(value):
+def json_safe(value):
     """NaN/inf (not valid JSON) to None, recursively."""
     if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
+        return {k: json_safe(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
+        return [json_safe(v) for v in value]
     return value
 
 
@@ -75,7 +75,7 @@ def write_manifest(folder: Path, manifest: dict) -> Path:
     """Write ``manifest`` to ``folder/run.json`` atomically; returns the path."""
     target = Path(folder) / MANIFEST_NAME
     with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8") as f:
-        json.dump(_json_safe(manifest), f, indent=2, allow_nan=False)
+        json.dump(json_safe(manifest), f, indent=2, allow_nan=False)
         f.write("\n")
     return target
 

@@ -15,7 +15,7 @@ ones), ``"interrupted"`` or ``"failed"`` (no member completed, or the ensemble i
 ``mode = "factor"`` parameter the factor), ``status`` (a member's run status, or
 ``"not run"``), ``wall_time_s``, ``error``.
 
-Both files are written atomically (a temporary file in the folder, then ``os.replace``).
+Both files are written atomically (``floodsph.atomic_files``), readable by the group.
 """
 
 from __future__ import annotations
@@ -23,13 +23,11 @@ from __future__ import annotations
 import csv
 import io
 import json
-import math
-import os
-import tempfile
 from pathlib import Path
 
 from floodsph._version import __version__
-from floodsph.manifest import now_iso
+from floodsph.atomic_files import atomic_path
+from floodsph.manifest import json_safe, now_iso
 
 ENSEMBLE_JSON = "ensemble.json"
 SAMPLES_CSV = "samples.csv"
@@ -66,21 +64,15 @@ def final_status(completed: int, failed: int) -> str:
 
 
 def _atomic_write(path: Path, text: str) -> Path:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8", newline="")
     return path
 
 
 def write_manifest(folder: Path, manifest: dict) -> Path:
     """Write ``folder/ensemble.json``."""
     return _atomic_write(Path(folder) / ENSEMBLE_JSON,
-                         json.dumps(_json_safe(manifest), indent=2, allow_nan=False) + "\n")
+                         json.dumps(json_safe(manifest), indent=2, allow_nan=False) + "\n")
 
 
 def read_manifest(folder: Path) -> dict | None:
@@ -89,16 +81,6 @@ def read_manifest(folder: Path) -> dict | None:
         return json.loads((Path(folder) / ENSEMBLE_JSON).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
-
-
-def _json_safe(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
-    return value
 
 
 def _cell(value) -> str:
