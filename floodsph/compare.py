@@ -102,7 +102,7 @@ def _ratio(num: float, den: float) -> float:
     return num / den
 
 
-def scores(hits: int, false_alarms: int, misses: int, correct_negatives: int = 0) -> dict:
+def scores(hits: int, false_alarms: int, misses: int) -> dict:
     """H, FAR, CSI, F2 and E from the contingency counts (see module docstring)."""
     union = hits + false_alarms + misses
     return {"hit_rate": _ratio(hits, hits + misses),
@@ -176,7 +176,8 @@ def compare(model_path, ref_path, threshold: float = 0.1, points=None,
     both = covered & wet_a & wet_b
     summary = {"model": str(model.path), "reference": str(ref.path), "kind": model.kind,
                "threshold_m": threshold if model.kind == "depth" else None,
-               "cells_compared": int(covered.sum()), **counts, **scores(**counts)}
+               "cells_compared": int(covered.sum()), **counts,
+               **scores(counts["hits"], counts["false_alarms"], counts["misses"])}
     if model.kind == "class":
         summary["class_agreement"] = _ratio(float(np.sum(a[both] == b[both])), both.sum())
     key = "arrival" if model.kind == "arrival" else "depth"

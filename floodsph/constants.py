@@ -5,6 +5,3 @@ GRAVITY = 9.81
 
 RHO_WATER = 1000.0
 """Density of water rho_w [kg m-3]; SPH areal density is rho = rho_w * d [kg m-2]."""
-
-DIM = 2
-"""Number of space dimensions d_m of the depth-averaged problem."""

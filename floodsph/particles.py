@@ -148,7 +148,3 @@ class ParticleSet:
         from floodsph.constants import RHO_WATER
 
         return float(self.m.sum() / RHO_WATER)
-
-    def snapshot(self) -> dict[str, np.ndarray]:
-        """Copies of all active arrays (for tests and checkpoints)."""
-        return {name: arr[: self.n].copy() for name, arr in self._data.items()}

@@ -31,7 +31,7 @@ def write(path, data, west=WEST, north=NORTH, crs="EPSG:32633", desc=None):
 
 
 def test_scores_from_counts_by_hand():
-    s = scores(hits=6, false_alarms=3, misses=2, correct_negatives=89)
+    s = scores(hits=6, false_alarms=3, misses=2)
     assert s["hit_rate"] == pytest.approx(6 / 8)
     assert s["false_alarm_ratio"] == pytest.approx(3 / 9)
     assert s["csi"] == pytest.approx(6 / 11)
