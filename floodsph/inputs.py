@@ -219,21 +219,19 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
 
 
 def inflow_hydrographs(scenario: Scenario) -> list:
-    """One :class:`~floodsph.hydrograph.Hydrograph` per ``[[inflows]]`` (CSV or routed breach)."""
+    """One :class:`~floodsph.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
+    one place it is read), or its breach (validated by ``floodsph.scenario``) routed."""
     from floodsph.hydrograph import Hydrograph, read_hydrograph
 
     source = str(scenario.path.name)
     out = []
     for i, inflow in enumerate(scenario.inflows):
-        where = f"{source}: inflows[{i}]"
         if inflow.hydrograph is not None:
-            out.append(read_hydrograph(inflow.hydrograph, f"{where}.hydrograph"))
+            out.append(read_hydrograph(inflow.hydrograph, f"{source}: inflows[{i}].hydrograph"))
         else:
-            from floodsph.breach import BreachParams, breach_hydrograph
+            from floodsph.breach import breach_hydrograph
 
-            table = {"method": inflow.breach.method, **inflow.breach.parameters}
-            params = BreachParams.from_mapping(table, f"inflows[{i}].breach", source=source)
-            t, Q, _ = breach_hydrograph(params)
+            t, Q, _ = breach_hydrograph(inflow.breach)
             out.append(Hydrograph(t, Q))
     return out
 

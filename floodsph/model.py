@@ -14,15 +14,14 @@ method notes 2.6-2.7):
 5. kick   v^{n+1} = v^{n+1/2} + a^{n+1} dt / 2, then implicit Manning friction over dt
 6. next dt = cfl min h / (|v| + c)
 
-With ``Numerics.time_stepping = "local"`` a call to :meth:`FloodModel.step` takes one big step
-of 2^K such steps, in which each particle does steps 1-5 at its own power-of-two multiple of
-the finest step (``floodsph.sph.local_steps``).
+With ``Numerics.time_stepping = TimeStepping.LOCAL`` a call to :meth:`FloodModel.step` takes
+one big step of 2^K such steps, in which each particle does steps 1-5 at its own power-of-two
+multiple of the finest step (``floodsph.sph.local_steps``).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -33,6 +32,7 @@ from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
 from floodsph.boundaries.open_edges import OpenEdges
 from floodsph.boundaries.openings import cut_openings
 from floodsph.constants import GRAVITY, RHO_WATER
+from floodsph.numerics import Numerics, Stabilisation, TimeStepping
 from floodsph.particles import ParticleSet
 from floodsph.sph import bed as bedmod
 from floodsph.sph import consistency, density, forces, local_steps, shore
@@ -42,55 +42,8 @@ from floodsph.terrain import Terrain
 
 MAX_SEARCH_GROWTH = 2.0
 """Cap on the factor ``hgrow`` by which a particle's neighbour search is widened."""
-TIME_STEPPING = ("global", "local")
-"""Values of ``Numerics.time_stepping``."""
 SETTLE_ROUNDS = 30
 """Rounds of list building and density solve when the model is set up (h may grow 10-fold)."""
-
-
-@dataclass(frozen=True)
-class Numerics:
-    """Numerical settings of the solver (defaults are the recommended production values).
-
-    cfl : Courant number of dt = cfl min h / (|v| + c).
-    kappa : h0 / particle spacing. 1.2 (SWE-SPHysics' suggested value, method notes 1.4): on
-        the square lattice the water is seeded on, still water is then a minimum of the SPH
-        energy and stays still; at 1.3, 1.25, 1.15 or 1.4-2 the lattice is a saddle of it and
-        a still lake stirs itself up within minutes (``workflows/lattice_stability.py``).
-    spacing : initial particle spacing [m].
-    density_tol : Newton-Raphson tolerance on |R| / rho.
-    density_max_iter : iteration cap of the density solve.
-    h_ratio : h is kept within [h0 / h_ratio, h0 h_ratio].
-    stabilisation : "lax-friedrichs" (parameter-free, default) or "riemann".
-    friction_depth_floor : depth floor [m] of the Manning term.
-    max_slope : bed slopes steeper than this are limited in the bed term.
-    neighbour_skin : relative margin of the neighbour lists.
-    reorder_interval : steps between spatial re-sorts of the particle arrays.
-    time_stepping : "global" (one step for all particles) or "local" (each particle at its
-        own power-of-two multiple of the finest step, ``floodsph.sph.local_steps``).
-    step_levels : K of local stepping: a big step holds 2^K finest steps.
-    """
-
-    cfl: float = 0.3
-    kappa: float = 1.2
-    spacing: float = 10.0
-    density_tol: float = 1e-3
-    density_max_iter: int = 20
-    h_ratio: float = 10.0
-    stabilisation: str = "lax-friedrichs"
-    friction_depth_floor: float = 0.01
-    max_slope: float = 1.0
-    neighbour_skin: float = 0.1
-    reorder_interval: int = 25
-    time_stepping: str = "global"
-    step_levels: int = 3
-
-    def __post_init__(self):
-        if self.time_stepping not in TIME_STEPPING:
-            raise ValueError(f"time_stepping: {self.time_stepping!r} is not one of "
-                             f"{list(TIME_STEPPING)}")
-        if self.step_levels < 0:
-            raise ValueError(f"step_levels must be >= 0, got {self.step_levels}")
 
 
 class FloodModel:
@@ -106,6 +59,7 @@ class FloodModel:
         (``floodsph.wall_seeding``): the set is changed in place, and
         ``volume_seed_adjustment`` [m3] is the volume change.
     numerics : Numerics
+        The solver's settings (``floodsph.numerics``), with ``particle_spacing_m`` given.
     walls : sequence of (k, 2) arrays
         Polylines in local coordinates that water cannot cross.
     closed_edges : bool or collection of str
@@ -123,15 +77,19 @@ class FloodModel:
         the boundaries once the particles have moved (``floodsph.refinement``).
     """
 
-    def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics = Numerics(),
+    def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
                  walls=(), closed_edges: bool = True, boundaries=(), refiner=None):
+        if numerics.particle_spacing_m is None:
+            raise ValueError("FloodModel: numerics.particle_spacing_m must be given (the "
+                             "scenario's default, the DEM cell size, is filled in by "
+                             "floodsph.run.build_model)")
         self.terrain = terrain
         self.boundaries = list(boundaries)
         self.refiner = refiner
         self.particles = particles
         self.numerics = numerics
-        self.scheme = {"lax-friedrichs": forces.LAX_FRIEDRICHS,
-                       "riemann": forces.RIEMANN}[numerics.stabilisation]
+        self.scheme = {Stabilisation.LAX_FRIEDRICHS: forces.LAX_FRIEDRICHS,
+                       Stabilisation.RIEMANN: forces.RIEMANN}[numerics.stabilisation]
         closed = set(OPEN_SIDES) if closed_edges is True else set(closed_edges or ())
         unknown = closed - set(OPEN_SIDES)
         if unknown:
@@ -140,14 +98,14 @@ class FloodModel:
         open_sides = [side for side in OPEN_SIDES if side not in closed]
         if open_sides:
             self.boundaries.insert(0, OpenEdges(terrain.width, terrain.height, open_sides))
-        h0 = numerics.kappa * numerics.spacing
+        h0 = numerics.kappa * numerics.particle_spacing_m
         segs = [wallmod.segments_from_polylines(walls),
                 _side_segments(terrain, closed, extension=6.0 * h0)]
         openings = [b.opening for b in self.boundaries if hasattr(b, "opening")]
         if closed_edges is not False:
             segs.append(wallmod.segments_from_polylines(
                 nodata_polylines(terrain.valid, terrain.dx, terrain.dy, openings)))
-        tol = 1e-6 * numerics.spacing
+        tol = 1e-6 * numerics.particle_spacing_m
         self.seg = split_at_junctions(cut_openings(np.concatenate(segs), openings, tol), tol)
         self.wall_index = wallmod.WallIndex(
             self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=2.0 * h0)
@@ -208,7 +166,7 @@ class FloodModel:
         self._nl_fresh = False
         if getattr(self, "nl", None) is None:  # particles were added or removed between steps
             self._neighbours()
-        if self.numerics.time_stepping == "local":
+        if self.numerics.time_stepping is TimeStepping.LOCAL:
             return self._step_local(dt_max)
         p = self.particles
         dt = self.dt if dt_max is None else min(self.dt, dt_max)
@@ -221,7 +179,7 @@ class FloodModel:
         p.u[:] += half * p.ax
         p.v[:] += half * p.ay
         forces.apply_friction(p.u, p.v, p.rho, self.bed[: p.n, 6], dt,
-                              self.numerics.friction_depth_floor)
+                              self.numerics.friction_depth_floor_m)
         self._advance_clock(dt)
         self.dt = self.stable_dt()
         return dt
@@ -260,7 +218,7 @@ class FloodModel:
             self._interactions(rows=end)
             end = np.arange(p.n, dtype=np.int64) if end is None else end
             local_steps.close_steps(end, p.stride, dt_f, p.u, p.v, p.ax, p.ay, p.rho,
-                                    self.bed[:, 6], self.numerics.friction_depth_floor)
+                                    self.bed[:, 6], self.numerics.friction_depth_floor_m)
             self._advance_clock(dt_f, end.size)
         self.dt = self.stable_dt()
         return n_sub * dt_f
@@ -336,8 +294,8 @@ class FloodModel:
         moved are removed and counted as outflow."""
         p, t = self.particles, self.terrain
         walled = self.closed_edges is not False
-        x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy, self.numerics.spacing,
-                                  self.seg if walled else None)
+        x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy,
+                                  self.numerics.particle_spacing_m, self.seg if walled else None)
         p.x[:], p.y[:] = x, y
         if lost.any():
             self.volume_out += float(p.m[lost].sum() / RHO_WATER)
@@ -364,7 +322,7 @@ class FloodModel:
         boundaries' zones, in still water (``wall_seeding.still_water``) and enclosed within
         ``wall_seeding.ENCLOSURE`` h (``wall_seeding.enclosed_seeds``)."""
         p = self.particles
-        dx = self.numerics.spacing
+        dx = self.numerics.particle_spacing_m
         n = p.n
         candidate = np.abs(p.m - rho_seed * dx * dx) <= 1e-9 * p.m
         candidate &= np.diff(self.walls_near[0][:n + 1]) > 0
@@ -395,7 +353,7 @@ class FloodModel:
         p = self.particles
         x0, y0 = p.x[idx].copy(), p.y[idx].copy()
         mx, my = np.zeros(p.n), np.zeros(p.n)
-        limit = wall_seeding.MAX_SHIFT * self.numerics.spacing
+        limit = wall_seeding.MAX_SHIFT * self.numerics.particle_spacing_m
         taken = 0
         while (taken < wall_seeding.SETTLE_STEPS
                and np.hypot(p.ax[idx], p.ay[idx]).max() >= wall_seeding.SETTLED * GRAVITY):
@@ -498,20 +456,20 @@ class FloodModel:
         h_predicted = p.h.copy()
         for _ in range(SETTLE_ROUNDS if settle else 2):
             self._blocked_pairs()
-            _, bad, capped, held = density.solve_density(
+            outcome = density.solve_density(
                 p, self.nl, self.blocked, self.wdist, self.walls_near, self.seg,
                 tol=num.density_tol, max_iter=num.density_max_iter, h_ratio=num.h_ratio,
                 cap=not settle)
             if settle and self.nl.covers(p.x, p.y, p.h):
                 break
-            if not settle and (capped == 0 or self._nl_fresh):
+            if not settle and (outcome.capped == 0 or self._nl_fresh):
                 break
             self._neighbours(force=True, rows=None if self.nl.complete else self.nl.rows)
         rows = self.nl.rows
         p.hgrow[rows] = p.h[rows] / h_predicted[rows]
-        self.counters["density_unconverged"] += bad
-        self.counters["density_capped"] += capped
-        self.counters["density_held"] += held
+        self.counters["density_unconverged"] += outcome.unconverged
+        self.counters["density_capped"] += outcome.capped
+        self.counters["density_held"] += outcome.held
 
     def _forces(self) -> None:
         p = self.particles

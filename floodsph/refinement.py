@@ -8,7 +8,9 @@ The numerics live in :mod:`floodsph.sph.refine`; this module selects the particl
 the bookkeeping. Total mass and linear momentum are unchanged to round-off by every split
 and every merge.
 
-Criteria (thresholds are multiples of the initial particle area A0 = spacing^2):
+Criteria (thresholds are multiples of the initial particle area A0 = spacing^2; each name
+below is a ``refine_*`` field of ``floodsph.numerics.Numerics``: area_max stands for
+``refine_area_max``, d_min for ``refine_d_min_m``, and so on):
 
 * split p when A_p > area_max A0, d_p >= d_min, level_p < max_level, and all seven daughters
   land on valid terrain on the parent's side of every wall, outside open-boundary zones;
@@ -55,14 +57,13 @@ refining it would only add particles.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.errors import InputError
+from floodsph.numerics import SMOOTHING_EXCESS, Numerics
 
-MODES = ("split+coalesce", "split", "none")
 HEXAGON_MARGIN = 1.01
 """Radius, relative to a parent's hexagon, within which wall segments are tested against the
 lines to its daughters (a segment across such a line is closer than the radius itself)."""
@@ -77,65 +78,6 @@ by its nearest particle of any size (:meth:`Refiner._absorptions`): its h is hal
 an area_min particle's, and such a particle, a shallow seed or a daughter carried into deep,
 fast water, sets the global time step (on Malpasset at 20 m the step-setting particles had h
 of 4-5 m among neighbours of 26 m)."""
-SMOOTHING_EXCESS = 3.0
-"""Default of ``Refinement.smoothing_excess``: split particles relax to h = sqrt(3) kappa
-sqrt(m / rho), not to the lattice value: on the coarse Ritter case (tests/test_refine.py) and
-the first 60 s of Malpasset this beat both no relaxation (L1 2.3 %, front 252 m behind; 128 s
-of wall time) and relaxation to the lattice value (L1 3.7 %; 77 s): L1 1.8 %, front 19 m,
-50 s. The Ritter convergence study is sensitive to it (``workflows/ritter_sensitivity.py``)."""
-
-
-@dataclass(frozen=True)
-class Refinement:
-    """Settings of splitting and coalescing (see the module docstring for the criteria).
-
-    mode : "split+coalesce", "split" or "none".
-    area_max : split above this area, in units of the initial particle area spacing^2.
-    area_min : merge candidates are below this area, same units (area_min < area_max / 2).
-    d_min : no splitting of particles shallower than this [m].
-    max_level : at most this many generations of splitting.
-    no_merge_steps : particles born within this many steps are not merged.
-    merge_interval : look for merges every this many steps.
-    depth_jump : no merge when |d_a - d_b| > depth_jump max(d_a, d_b).
-    speed_jump : no merge when |v_a - v_b| > speed_jump sqrt(g max(d_a, d_b)).
-    smoothing_excess : split particles relax to h^2 rho = smoothing_excess kappa^2 m
-        (:func:`relax_smoothing`; 1 is the lattice value).
-    """
-
-    mode: str = "split+coalesce"
-    area_max: float = 2.0
-    area_min: float = 0.9
-    d_min: float = 0.01
-    max_level: int = 3
-    no_merge_steps: int = 10
-    merge_interval: int = 5
-    depth_jump: float = 0.5
-    speed_jump: float = 0.5
-    smoothing_excess: float = SMOOTHING_EXCESS
-
-    def __post_init__(self):
-        if self.mode not in MODES:
-            raise InputError(f"numerics.refinement: {self.mode!r} is not one of {list(MODES)}")
-        if not 0.0 < self.area_min < self.area_max / 2.0:
-            raise InputError(
-                f"refinement: need 0 < area_min < area_max / 2 so that a merged pair is not "
-                f"split again at once; got area_min={self.area_min}, area_max={self.area_max}")
-        if self.d_min < 0.0 or self.max_level < 0 or self.no_merge_steps < 0:
-            raise InputError("refinement: d_min, max_level and no_merge_steps must be >= 0")
-        if not self.smoothing_excess >= 1.0:
-            raise InputError(f"refinement: smoothing_excess must be >= 1 (the lattice value), "
-                             f"got {self.smoothing_excess}")
-        if self.merge_interval < 1:
-            raise InputError(f"refinement: merge_interval must be >= 1, got "
-                             f"{self.merge_interval}")
-
-    @property
-    def splits(self) -> bool:
-        return self.mode != "none"
-
-    @property
-    def coalesces(self) -> bool:
-        return self.mode == "split+coalesce"
 
 
 class Refiner:
@@ -143,29 +85,29 @@ class Refiner:
 
     Parameters
     ----------
-    settings : Refinement
-    spacing : float
-        Initial particle spacing [m]; the area thresholds are multiples of spacing^2.
+    numerics : Numerics
+        Its ``refinement`` mode and ``refine_*`` thresholds, and the initial particle spacing
+        ``particle_spacing_m`` [m]: the area thresholds are multiples of spacing^2.
     """
 
-    def __init__(self, settings: Refinement, spacing: float):
-        if not spacing > 0.0:
-            raise InputError(f"refinement: particle spacing must be > 0 m, got {spacing}")
-        self.settings = settings
+    def __init__(self, numerics: Numerics):
+        spacing = numerics.particle_spacing_m
+        if spacing is None:
+            raise InputError("refinement: numerics.particle_spacing_m must be given")
+        self.numerics = numerics
         self.spacing = float(spacing)
-        self.area_max = settings.area_max * self.spacing**2
-        self.area_min = settings.area_min * self.spacing**2
+        self.area_max = numerics.refine_area_max * self.spacing**2
+        self.area_min = numerics.refine_area_min * self.spacing**2
         self._last_call = -1  # model.steps at the last apply: merges are due every
-        # merge_interval steps, also when a call ends several steps (local time stepping)
+        # refine_merge_interval steps, also when a call ends several (local time stepping)
 
     @classmethod
-    def from_settings(cls, mode: str, spacing: float, **overrides) -> Refiner | None:
-        """The refiner of a scenario's ``numerics.refinement`` mode (None for "none")."""
-        settings = Refinement(mode=mode, **overrides)
-        return cls(settings, spacing) if settings.splits else None
+    def of(cls, numerics: Numerics) -> Refiner | None:
+        """The refiner of ``numerics.refinement`` (None for ``Refinement.NONE``)."""
+        return cls(numerics) if numerics.refinement.splits else None
 
     def __repr__(self) -> str:
-        return f"Refiner({self.settings}, spacing={self.spacing})"
+        return f"Refiner({self.numerics.refinement}, spacing={self.spacing})"
 
     def apply(self, model) -> tuple[int, int]:
         """Split and coalesce the particles of ``model`` in place; return (splits, merges).
@@ -175,17 +117,18 @@ class Refiner:
         call first relaxes over-smoothed particles (:func:`relax_smoothing`), by the
         compounded rate of the steps since the last call (several with local time stepping).
         """
-        s = self.settings
+        s = self.numerics
         steps = model.steps - self._last_call
-        merge_due = model.steps // s.merge_interval != self._last_call // s.merge_interval
+        every = s.refine_merge_interval
+        merge_due = model.steps // every != self._last_call // every
         self._last_call = model.steps
-        if not s.splits or model.particles.n == 0:
+        if not s.refinement.splits or model.particles.n == 0:
             return 0, 0
         rate = RELAX_RATE if steps == 1 else 1.0 - (1.0 - RELAX_RATE) ** steps
-        relax_smoothing(model.particles, model.numerics.kappa, rate, s.smoothing_excess)
+        relax_smoothing(model.particles, model.numerics.kappa, rate, s.refine_smoothing_excess)
         parents = self.split_candidates(model)
         a = b = np.zeros(0, dtype=np.int64)
-        if s.coalesces and merge_due:
+        if s.refinement.coalesces and merge_due:
             a, b = self.merge_pairs(model)
         if parents.size == 0 and a.size == 0:
             return 0, 0
@@ -220,15 +163,15 @@ class Refiner:
         from floodsph.sph import refine
 
         p = model.particles
-        s = self.settings
-        big = (p.m > self.area_max * p.rho) & (p.rho >= RHO_WATER * s.d_min)
-        big &= p.level < s.max_level
+        s = self.numerics
+        big = (p.m > self.area_max * p.rho) & (p.rho >= RHO_WATER * s.refine_d_min_m)
+        big &= p.level < s.refine_max_level
         for boundary in getattr(model, "boundaries", ()):
             big &= ~boundary.protected(p.x, p.y)
         idx = np.flatnonzero(big)
         if idx.size == 0:
             return idx
-        h_parent = _parent_h(p, idx, model.numerics.kappa, s.smoothing_excess)
+        h_parent = _parent_h(p, idx, model.numerics.kappa, s.refine_smoothing_excess)
         x, y, _ = _daughter_positions(p, idx, h_parent)
         walled = model.closed_edges is not False
         ok = _on_terrain(model.terrain, x, y, nodata_ok=walled)
@@ -252,7 +195,8 @@ class Refiner:
         if idx.size == 0:
             return None
         p = model.particles
-        h_parent = _parent_h(p, idx, model.numerics.kappa, self.settings.smoothing_excess)
+        h_parent = _parent_h(p, idx, model.numerics.kappa,
+                             self.numerics.refine_smoothing_excess)
         x, y, m = _daughter_positions(p, idx, h_parent)
         rep = np.repeat(idx, refine.DAUGHTERS)
         h = refine.H_FACTOR * np.repeat(h_parent, refine.DAUGHTERS)
@@ -267,9 +211,8 @@ class Refiner:
         nearest candidates (a < b), then the small candidates left and their absorbers
         (:meth:`_absorptions`; a is the small one)."""
         p = model.particles
-        s = self.settings
         idx = np.flatnonzero((p.m < self.area_min * p.rho)
-                             & (model.steps - p.born >= s.no_merge_steps))
+                             & (model.steps - p.born >= self.numerics.refine_no_merge_steps))
         if idx.size:  # the wall test covers the support of the merged particle, too
             reach_h = np.maximum(p.h[idx], model.numerics.kappa
                                  * np.sqrt(2.0 * p.m[idx] / p.rho[idx]))
@@ -299,13 +242,13 @@ class Refiner:
         b = nn[a]
         mutual = nn[b] == a
         a, b = idx[a[mutual]], idx[b[mutual]]
-        s = self.settings
+        s = self.numerics
         d_a, d_b = p.rho[a] / RHO_WATER, p.rho[b] / RHO_WATER
         d_max = np.maximum(d_a, d_b)
         dv = np.hypot(p.u[a] - p.u[b], p.v[a] - p.v[b])
         r = np.hypot(p.x[a] - p.x[b], p.y[a] - p.y[b])
-        ok = (np.abs(d_a - d_b) <= s.depth_jump * d_max)
-        ok &= dv <= s.speed_jump * np.sqrt(GRAVITY * d_max)
+        ok = (np.abs(d_a - d_b) <= s.refine_depth_jump * d_max)
+        ok &= dv <= s.refine_speed_jump * np.sqrt(GRAVITY * d_max)
         ok &= r < np.minimum(p.h[a], p.h[b])
         return a[ok], b[ok]
 
@@ -337,7 +280,7 @@ class Refiner:
         partner = np.ones(n, dtype=np.bool_)
         partner[paired] = False
         partner[small] = False
-        partner &= model.steps - p.born[:n] >= self.settings.no_merge_steps
+        partner &= model.steps - p.born[:n] >= self.numerics.refine_no_merge_steps
         nn = np.full(n, -1, dtype=np.int64)
         refine.nearest_of(small, p.x, p.y, near.start, near.nbr, partner, nn)
         t = small[nn[small] >= 0]
@@ -349,7 +292,7 @@ class Refiner:
         keep[1:] = b[first[1:]] != b[first[:-1]]
         t, b, r = t[first[keep]], b[first[keep]], r[first[keep]]
         dv = np.hypot(p.u[t] - p.u[b], p.v[t] - p.v[b])
-        ok = (dv <= self.settings.speed_jump * np.sqrt(GRAVITY * p.rho[b] / RHO_WATER))
+        ok = (dv <= self.numerics.refine_speed_jump * np.sqrt(GRAVITY * p.rho[b] / RHO_WATER))
         ok &= r < p.h[b]
         ok &= p.m[t] / p.rho[t] + p.m[b] / p.rho[b] < 2.0 * self.area_min
         t, b = t[ok], b[ok]

@@ -272,22 +272,17 @@ def set_threads(threads: int) -> int:
 
 
 def build_model(scenario: Scenario, inputs):
-    """The FloodModel of ``scenario`` from prepared inputs, with its open boundaries."""
-    from floodsph.model import FloodModel, Numerics
+    """The FloodModel of ``scenario`` from prepared inputs, with its open boundaries.
+
+    The model's numerics are the scenario's, with ``particle_spacing_m`` the spacing the
+    particles were seeded at (the DEM cell size when the scenario gives none).
+    """
+    from dataclasses import replace
+
+    from floodsph.model import FloodModel
     from floodsph.refinement import Refiner
 
-    num = scenario.numerics
-    numerics = Numerics(
-        cfl=num.cfl,
-        kappa=num.kappa,
-        spacing=inputs.spacing_m,
-        density_tol=num.density_tol,
-        stabilisation=num.stabilisation.value,
-        friction_depth_floor=num.friction_depth_floor_m,
-        max_slope=num.max_slope,
-        time_stepping=num.time_stepping.value,
-        step_levels=num.step_levels,
-    )
+    numerics = replace(scenario.numerics, particle_spacing_m=inputs.spacing_m)
     return FloodModel(
         inputs.terrain,
         inputs.particles,
@@ -295,11 +290,7 @@ def build_model(scenario: Scenario, inputs):
         walls=inputs.walls,
         closed_edges=_closed_edges(scenario.terrain),
         boundaries=open_boundaries(scenario, inputs, numerics),
-        refiner=Refiner.from_settings(num.refinement.value, inputs.spacing_m,
-                                      area_max=num.refine_area_max,
-                                      area_min=num.refine_area_min,
-                                      d_min=num.refine_d_min_m,
-                                      max_level=num.refine_max_level),
+        refiner=Refiner.of(numerics),
     )
 
 
@@ -322,9 +313,9 @@ def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
     for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,
                                                  strict=True)):
         line = np.column_stack(terrain.to_local(*np.asarray(inflow.line, dtype=np.float64).T))
-        out.append(Inflow(line, hydrograph, numerics.spacing, numerics.kappa, terrain,
+        out.append(Inflow(line, hydrograph, numerics.particle_spacing_m, numerics.kappa, terrain,
                           direction=inflow.direction, name=f"{source}: inflows[{i}]"))
-    reach = 4.0 * numerics.kappa * numerics.spacing
+    reach = 4.0 * numerics.kappa * numerics.particle_spacing_m
     for sink in scenario.sinks:
         polygon = np.column_stack(terrain.to_local(*np.asarray(sink.polygon, dtype=np.float64).T))
         out.append(Sink(polygon, terrain, reach))

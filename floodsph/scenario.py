@@ -13,18 +13,22 @@ when the model is built (``floodsph.run``).
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from enum import Enum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from floodsph.checks.elevation import ELEVATION_LIMIT_M
-from floodsph.checks.roughness import N_STRICKLER, strickler_text
+from floodsph.checks.roughness import N_DEFAULT, N_STRICKLER, strickler_text
 from floodsph.errors import InputError
-from floodsph.refinement import Refinement as RefinementSettings
+from floodsph.numerics import SCENARIO_KEYS as NUMERICS_KEYS
+from floodsph.numerics import Numerics, NumericsError
 from floodsph.scenario_schema import Reader, describe, join
 
+if TYPE_CHECKING:
+    from floodsph.breach.params import BreachParams
+
 Point = tuple[float, float]
-REFINE_DEFAULTS = RefinementSettings()
 
 
 class Edges(Enum):
@@ -32,28 +36,6 @@ class Edges(Enum):
 
     OPEN = "open"
     CLOSED = "closed"
-
-
-class Refinement(Enum):
-    """Dynamic particle refinement (Vacondio et al. 2013): splitting and coalescing."""
-
-    SPLIT_COALESCE = "split+coalesce"
-    SPLIT = "split"
-    NONE = "none"
-
-
-class TimeStepping(Enum):
-    """One time step for every particle, or each at its own (``floodsph.sph.local_steps``)."""
-
-    GLOBAL = "global"
-    LOCAL = "local"
-
-
-class Stabilisation(Enum):
-    """Numerical dissipation of the momentum equation."""
-
-    LAX_FRIEDRICHS = "lax-friedrichs"
-    RIEMANN = "riemann"
 
 
 class OutputFormat(Enum):
@@ -82,7 +64,7 @@ class TerrainConfig:
     dem: Path
     crs: str | None = None
     dem_variable: str | None = None
-    manning: float | Path | None = 0.035
+    manning: float | Path | None = N_DEFAULT
     landcover: Path | None = None
     manning_table: Path | None = None
     extent: tuple[float, float, float, float] | None = None
@@ -117,21 +99,12 @@ class Wall:
 
 
 @dataclass(frozen=True)
-class Breach:
-    """``[inflows.breach]``: a parametric breach turned into a hydrograph (``floodsph.breach``).
-
-    ``method`` names the breach model; ``parameters`` holds its other keys as given, with file
-    paths made absolute (they are validated by ``floodsph.breach.params.BreachParams``, which
-    owns their meaning).
-    """
-
-    method: str
-    parameters: dict = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
 class Inflow:
     """``[[inflows]]``: a breach section with a discharge hydrograph Q(t) [m3/s].
+
+    ``hydrograph`` is the CSV of Q(t) (read by ``floodsph.inputs``, as every file the scenario
+    names); ``breach`` the validated ``[inflows.breach]`` table of a parametric breach
+    (``floodsph.breach.params.BreachParams``, file paths absolute), routed into Q(t) there.
 
     ``direction`` (optional) is the flow direction [dx, dy]; by default water enters normal
     to ``line`` towards lower ground.
@@ -139,7 +112,7 @@ class Inflow:
 
     line: tuple[Point, Point]
     hydrograph: Path | None = None
-    breach: Breach | None = None
+    breach: BreachParams | None = None
     direction: Point | None = None
 
 
@@ -156,34 +129,6 @@ class Gauges:
 
     file: Path
     interval_s: float = 10.0
-
-
-@dataclass(frozen=True)
-class NumericsConfig:
-    """``[numerics]``: the solver's tunables (see ``floodsph.model.Numerics``).
-
-    ``particle_spacing_m = None`` means the DEM cell size; ``threads = 0`` means all cores.
-    ``refine_*`` are the splitting and coalescing thresholds of ``floodsph.refinement``
-    (areas in units of particle_spacing_m^2, the split depth floor in m, the generations).
-    ``time_stepping = "local"`` lets each particle step at its own power-of-two multiple of the
-    finest step, up to 2^step_levels of them (``floodsph.sph.local_steps``).
-    """
-
-    particle_spacing_m: float | None = None
-    cfl: float = 0.3
-    refinement: Refinement = Refinement.SPLIT_COALESCE
-    threads: int = 0
-    kappa: float = 1.2
-    stabilisation: Stabilisation = Stabilisation.LAX_FRIEDRICHS
-    density_tol: float = 1e-3
-    friction_depth_floor_m: float = 0.01
-    max_slope: float = 1.0
-    refine_area_max: float = REFINE_DEFAULTS.area_max
-    refine_area_min: float = REFINE_DEFAULTS.area_min
-    refine_d_min_m: float = REFINE_DEFAULTS.d_min
-    refine_max_level: int = REFINE_DEFAULTS.max_level
-    time_stepping: TimeStepping = TimeStepping.GLOBAL
-    step_levels: int = 3
 
 
 @dataclass(frozen=True)
@@ -216,7 +161,7 @@ class Scenario:
     inflows: tuple[Inflow, ...] = ()
     sinks: tuple[Sink, ...] = ()
     gauges: Gauges | None = None
-    numerics: NumericsConfig = NumericsConfig()
+    numerics: Numerics = Numerics()
     output: OutputConfig = OutputConfig()
 
     @property
@@ -263,13 +208,12 @@ class Scenario:
 
 
 def _plain(value):
-    """Dataclasses, enums, paths and tuples to dicts, strings and lists; drops ``None``."""
+    """Dataclasses, enums, paths and tuples to dicts, strings and lists; drops ``None`` and the
+    fields that are no scenario keys (``metadata["scenario"]`` False)."""
     if hasattr(value, "__dataclass_fields__"):
-        items = ((f.name, _plain(getattr(value, f.name))) for f in fields(value))
-        out = {k: v for k, v in items if v is not None}
-        if isinstance(value, Breach):
-            out = {"method": value.method, **value.parameters}
-        return out
+        items = ((f.name, _plain(getattr(value, f.name))) for f in fields(value)
+                 if f.metadata.get("scenario", True))
+        return {k: v for k, v in items if v is not None}
     if isinstance(value, Enum):
         return value.value
     if isinstance(value, Path):
@@ -487,32 +431,21 @@ def _inflow(r: Reader, t: dict, p: str) -> Inflow:
             raise r.fail(join(p, "direction"), "must not be the zero vector")
     breach = _breach(r, t["breach"], join(p, "breach")) if "breach" in t else None
     hydrograph = r.existing_file(t, p, "hydrograph", None)
-    if hydrograph is not None:
-        _check_hydrograph(hydrograph, join(p, "hydrograph"), r)
     return Inflow(line=line, hydrograph=hydrograph, breach=breach, direction=direction)
 
 
-def _check_hydrograph(path: Path, where: str, r: Reader) -> None:
-    """Read the hydrograph CSV now, so a bad table stops the run before it starts."""
-    from floodsph.hydrograph import read_hydrograph
+def _breach(r: Reader, value, where: str) -> BreachParams:
+    """``[inflows.breach]`` validated by the breach module, its files made absolute and
+    checked to exist (they are read when the breach is routed, ``floodsph.inputs``)."""
+    from dataclasses import replace
 
-    read_hydrograph(path, f"{r.source}: {where}")
-
-
-def _breach(r: Reader, value, where: str) -> Breach:
-    """Validate ``[inflows.breach]`` with the breach module; keep it with absolute paths."""
     from floodsph.breach.params import BreachParams
 
-    table = r.table(value, where)
-    checked = BreachParams.from_mapping(table, where, r.base_dir, source=r.source)
-    params = {}
-    for key, given in table.items():
-        value = getattr(checked, key)
-        if isinstance(value, Path):
-            given = str(r.file_value(str(value), join(where, key)))
-        if key != "method":
-            params[key] = given
-    return Breach(method=table.get("method", "froehlich2008"), parameters=params)
+    params = BreachParams.from_mapping(r.table(value, where), where, r.base_dir,
+                                       source=r.source)
+    files = {f.name: r.file_value(str(getattr(params, f.name)), join(where, f.name))
+             for f in fields(params) if isinstance(getattr(params, f.name), Path)}
+    return replace(params, **files)
 
 
 def _sink(r: Reader, t: dict, p: str) -> Sink:
@@ -530,36 +463,26 @@ def _gauges(r: Reader, data: dict) -> Gauges | None:
     )
 
 
-def _numerics(r: Reader, data: dict) -> NumericsConfig:
+def _numerics(r: Reader, data: dict) -> Numerics:
+    """``[numerics]`` straight into :class:`~floodsph.numerics.Numerics`: each key read as the
+    type of its field, then checked by ``Numerics`` itself (bounds, the refinement rule)."""
     p = "numerics"
-    keys = tuple(f.name for f in fields(NumericsConfig))
-    t = r.sub_table(data, "", p, keys)
-    d = NumericsConfig()
-    out = NumericsConfig(
-        particle_spacing_m=r.number(t, p, "particle_spacing_m", None, gt=0.0),
-        cfl=r.number(t, p, "cfl", d.cfl, gt=0.0, le=1.0),
-        refinement=r.choice(t, p, "refinement", Refinement, d.refinement),
-        threads=r.integer(t, p, "threads", d.threads, ge=0),
-        kappa=r.number(t, p, "kappa", d.kappa, gt=0.0),
-        stabilisation=r.choice(t, p, "stabilisation", Stabilisation, d.stabilisation),
-        density_tol=r.number(t, p, "density_tol", d.density_tol, gt=0.0),
-        friction_depth_floor_m=r.number(
-            t, p, "friction_depth_floor_m", d.friction_depth_floor_m, gt=0.0
-        ),
-        max_slope=r.number(t, p, "max_slope", d.max_slope, gt=0.0),
-        refine_area_max=r.number(t, p, "refine_area_max", d.refine_area_max, gt=0.0),
-        refine_area_min=r.number(t, p, "refine_area_min", d.refine_area_min, gt=0.0),
-        refine_d_min_m=r.number(t, p, "refine_d_min_m", d.refine_d_min_m, ge=0.0),
-        refine_max_level=r.integer(t, p, "refine_max_level", d.refine_max_level, ge=0),
-        time_stepping=r.choice(t, p, "time_stepping", TimeStepping, d.time_stepping),
-        step_levels=r.integer(t, p, "step_levels", d.step_levels, ge=0, le=6),
-    )
-    if not out.refine_area_min < out.refine_area_max / 2.0:
-        raise r.fail(join(p, "refine_area_min"),
-                     f"must be below refine_area_max / 2 = {out.refine_area_max / 2.0:g} so "
-                     f"that a merged pair is not split again at once; got "
-                     f"{out.refine_area_min:g}")
-    return out
+    t = r.sub_table(data, "", p, NUMERICS_KEYS)
+    values = {}
+    for f in fields(Numerics):
+        if f.name not in t:
+            continue
+        kind = f.metadata["kind"]
+        if issubclass(kind, Enum):
+            values[f.name] = r.choice(t, p, f.name, kind, f.default)
+        elif kind is int:
+            values[f.name] = r.integer(t, p, f.name)
+        else:
+            values[f.name] = r.number(t, p, f.name)
+    try:
+        return Numerics(**values)
+    except NumericsError as exc:
+        raise r.fail(join(p, exc.key), exc.problem) from None
 
 
 def _output(r: Reader, data: dict) -> OutputConfig:

@@ -25,7 +25,8 @@ import numpy as np
 
 from floodsph import testing as exact
 from floodsph.constants import RHO_WATER
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics, Refinement
 from floodsph.output.rasterise import interpolate
 from floodsph.particles import ParticleSet
 from floodsph.terrain import Terrain
@@ -58,10 +59,10 @@ class CaseResult:
         return self.interactions / self.wall_s
 
 
-def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, refinement=None,
-                   **numerics):
+def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **numerics):
     """A FloodModel on an analytic bed with particles on a lattice of spacing dx where the
-    depth exceeds 1 mm; ``refinement`` (a ``floodsph.refinement.Refinement``) adds a refiner."""
+    depth exceeds 1 mm; ``numerics``: fields of its ``Numerics`` (``refinement`` default
+    ``Refinement.NONE``: uniform resolution; another mode adds a refiner)."""
     from floodsph.refinement import Refiner
 
     terrain = Terrain.from_function(bed, xlim, ylim, cell)
@@ -76,8 +77,9 @@ def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, refine
              else u,
              v=np.broadcast_to(v(x + terrain.x0, y + terrain.y0), x.shape)[wet] if callable(v)
              else v)
-    refiner = Refiner(refinement, dx) if refinement is not None and refinement.splits else None
-    return FloodModel(terrain, p, Numerics(spacing=dx, kappa=kappa, **numerics), refiner=refiner)
+    num = Numerics(particle_spacing_m=dx, kappa=kappa,
+                   **{"refinement": Refinement.NONE, **numerics})
+    return FloodModel(terrain, p, num, refiner=Refiner.of(num))
 
 
 def _run(model, t_end):
@@ -94,12 +96,13 @@ def _run(model, t_end):
     return time.perf_counter() - t0, model.counters["particle_updates"] - pst, pairs
 
 
-def _labels(refinement, model) -> tuple:
-    """(mode, particles_max, splits, merges, time_stepping) of a finished run, for
+def _labels(model) -> tuple:
+    """(refinement, particles_max, splits, merges, time_stepping) of a finished run, for
     ``CaseResult``."""
     c = model.counters
-    mode = "none" if refinement is None else refinement.mode
-    return mode, c["particles_max"], c["splits"], c["merges"], model.numerics.time_stepping
+    num = model.numerics
+    return (num.refinement.value, c["particles_max"], c["splits"], c["merges"],
+            num.time_stepping.value)
 
 
 def _depth_at(model, qx, qy):
@@ -114,14 +117,13 @@ def _channel_profile(model, xq):
     return _depth_at(model, X.ravel(), Y.ravel()).reshape(X.shape).mean(axis=0)
 
 
-def ritter(dx: float, kappa: float = Numerics.kappa, refinement=None,
-           **numerics) -> CaseResult:
-    """Dry-bed dam break (Ritter), d0 = 10 m, t = 50 s; ``refinement`` a ``Refinement``
-    (default: uniform resolution)."""
+def ritter(dx: float, kappa: float = Numerics.kappa, **numerics) -> CaseResult:
+    """Dry-bed dam break (Ritter), d0 = 10 m, t = 50 s; ``numerics``: fields of the model's
+    ``Numerics`` (``refinement`` default: ``Refinement.NONE``, uniform resolution)."""
     d0, t_end = 10.0, 50.0
     model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
                            lambda x, y: np.where(x < 1000, d0, 0.0), dx, kappa,
-                           refinement=refinement, **numerics)
+                           **numerics)
     v0 = model.volume()
     wall, pst, pairs = _run(model, t_end)
     xq = np.arange(0.5, 2000, 1.0)
@@ -130,16 +132,15 @@ def ritter(dx: float, kappa: float = Numerics.kappa, refinement=None,
     front = exact.front_position(xq, d, 0.1) - exact.front_position(xq, d_ex, 0.1)
     return CaseResult("ritter", dx, model.particles.n, model.steps, wall, pst, pairs,
                       exact.l1_relative(d, d_ex), float(front),
-                      abs(model.volume() - v0) / v0, *_labels(refinement, model))
+                      abs(model.volume() - v0) / v0, *_labels(model))
 
 
-def stoker(dx: float, kappa: float = Numerics.kappa, refinement=None,
-           **numerics) -> CaseResult:
+def stoker(dx: float, kappa: float = Numerics.kappa, **numerics) -> CaseResult:
     """Wet-bed dam break (Stoker), 10 m over 2 m, t = 50 s."""
     d_l, d_r, t_end = 10.0, 2.0, 50.0
     model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
                            lambda x, y: np.where(x < 1000, d_l, d_r), dx, kappa,
-                           refinement=refinement, **numerics)
+                           **numerics)
     v0 = model.volume()
     wall, pst, pairs = _run(model, t_end)
     xq = np.arange(0.5, 2000, 1.0)
@@ -151,10 +152,10 @@ def stoker(dx: float, kappa: float = Numerics.kappa, refinement=None,
     front = bore - exact.stoker_bore_position(t_end, d_l, d_r, x_dam=1000.0)
     return CaseResult("stoker", dx, model.particles.n, model.steps, wall, pst, pairs,
                       exact.l1_relative(d, d_ex), float(front),
-                      abs(model.volume() - v0) / v0, *_labels(refinement, model))
+                      abs(model.volume() - v0) / v0, *_labels(model))
 
 
-def thacker(dx: float, kappa: float = Numerics.kappa, periods: float = 1.0, refinement=None,
+def thacker(dx: float, kappa: float = Numerics.kappa, periods: float = 1.0,
             **numerics) -> CaseResult:
     """Thacker's planar surface in a paraboloid, frictionless, over ``periods`` periods."""
     h0, a, eta = 10.0, 3000.0, 1500.0
@@ -163,8 +164,7 @@ def thacker(dx: float, kappa: float = Numerics.kappa, periods: float = 1.0, refi
         lambda x, y: h0 * (x**2 + y**2) / a**2, (-5000, 5000), (-5000, 5000), 50.0,
         lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[0], dx, kappa,
         u=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[1],
-        v=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[2], refinement=refinement,
-        **numerics)
+        v=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[2], **numerics)
     v0 = model.volume()
     wall, pst, pairs = _run(model, t_end)
     xq = np.arange(-4975.0, 5000.0, 50.0)
@@ -176,7 +176,7 @@ def thacker(dx: float, kappa: float = Numerics.kappa, periods: float = 1.0, refi
     r_wet = np.hypot(X.ravel() - eta, Y.ravel())[(d > 1e-3)]
     shore = float(r_wet.max() - a) if r_wet.size else np.nan
     return CaseResult("thacker", dx, model.particles.n, model.steps, wall, pst, pairs, l1,
-                      shore, abs(model.volume() - v0) / v0, *_labels(refinement, model))
+                      shore, abs(model.volume() - v0) / v0, *_labels(model))
 
 
 CASES = {"ritter": ritter, "stoker": stoker, "thacker": thacker}

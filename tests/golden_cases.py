@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.numerics import Refinement, TimeStepping
+
 GOLDEN = Path(__file__).resolve().parent / "golden"
 THREADS = 2
 
@@ -21,11 +23,8 @@ THREADS = 2
 def _analytic(name: str, dx: float, **options) -> dict:
     """One ``floodsph.verification`` case, with its depth profile along the channel."""
     from floodsph import verification
-    from floodsph.refinement import Refinement
 
-    mode = options.pop("refinement", None)
-    refinement = None if mode is None else Refinement(mode)
-    result = verification.CASES[name](dx, refinement=refinement, **options)
+    result = verification.CASES[name](dx, **options)
     return {"particles": result.particles, "steps": result.steps,
             "particles_max": result.particles_max, "splits": result.splits,
             "merges": result.merges, "l1": result.l1, "front_error_m": result.front_error_m,
@@ -63,8 +62,9 @@ CASES = {
     "stoker_20m": lambda tmp: _analytic("stoker", 20.0),
     "thacker_250m": lambda tmp: _analytic("thacker", 250.0),
     "ritter_20m_split_coalesce": lambda tmp: _analytic("ritter", 20.0,
-                                                       refinement="split+coalesce"),
-    "ritter_20m_local_steps": lambda tmp: _analytic("ritter", 20.0, time_stepping="local"),
+                                                       refinement=Refinement.SPLIT_COALESCE),
+    "ritter_20m_local_steps": lambda tmp: _analytic("ritter", 20.0,
+                                                    time_stepping=TimeStepping.LOCAL),
     "inflow_open_edges_refined_local": _scenario_run,
 }
 

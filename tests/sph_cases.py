@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from floodsph.constants import RHO_WATER
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics
 from floodsph.particles import ParticleSet
 from floodsph.terrain import Terrain
 
@@ -37,7 +38,7 @@ def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, ma
     else:
         d = np.maximum(level_or_depth - bed(xw, yw), 0.0)
     p = particles_with_depth(x, y, np.asarray(d, dtype=float), dx, kappa)
-    num = Numerics(spacing=dx, kappa=kappa, **numerics)
+    num = Numerics(particle_spacing_m=dx, kappa=kappa, **numerics)
     return FloodModel(terrain, p, num, walls=walls, closed_edges=closed)
 
 

@@ -23,7 +23,8 @@ from floodsph.boundaries.riemann import critical_depth, inflow_state
 from floodsph.constants import GRAVITY
 from floodsph.errors import InputError
 from floodsph.hydrograph import Hydrograph
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics
 from floodsph.terrain import Terrain
 
 G = GRAVITY
@@ -69,7 +70,7 @@ def test_lattice_alpha_ratio_matches_the_solver_on_a_lattice():
     terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 200), (0, 200), 5.0)
     x, y = lattice(0, 200, 0, 200, 10.0)
     model = FloodModel(terrain, particles_with_depth(x, y, np.full(x.shape, 2.0), 10.0, KAPPA),
-                       Numerics(spacing=10.0))
+                       Numerics(particle_spacing_m=10.0))
     p = model.particles
     centre = np.argmin(np.hypot(p.x - 100, p.y - 100))
     assert lattice_alpha_ratio(10.0, 10.0, p.h[centre]) == pytest.approx(
@@ -124,7 +125,7 @@ def test_floodplain_inflow_injects_the_hydrograph_volume():
     hg = Hydrograph([0.0, 30.0, 150.0, 180.0], [0.0, 20.0, 20.0, 0.0])
     inflow = Inflow([[0, 90], [0, 110]], hg, dx, KAPPA, terrain)
     model = FloodModel(terrain, particles_with_depth(np.zeros(0), np.zeros(0), np.zeros(0), dx,
-                                                     KAPPA), Numerics(spacing=dx),
+                                                     KAPPA), Numerics(particle_spacing_m=dx),
                        boundaries=[inflow])
     row = critical_depth(1.0) * 20.0 * dx  # volume of one buffer row at the peak [m3]
     fronts, lags = [], []
@@ -151,7 +152,7 @@ def test_injected_volume_matches_the_hydrograph_from_trickle_to_steep_rise(times
     hg = Hydrograph(times, discharges)
     inflow = Inflow([[0, 40], [0, 60]], hg, dx, KAPPA, terrain)
     empty = particles_with_depth(np.zeros(0), np.zeros(0), np.zeros(0), dx, KAPPA)
-    model = FloodModel(terrain, empty, Numerics(spacing=dx), boundaries=[inflow])
+    model = FloodModel(terrain, empty, Numerics(particle_spacing_m=dx), boundaries=[inflow])
     for t in np.linspace(5.0, times[-1], 8):
         run_until(model, t)
         v = hg.volume(0.0, t)
@@ -167,7 +168,7 @@ def test_still_water_at_an_open_edge_does_not_drain():
     terrain = _flat(300, 100)
     x, y = lattice(0, 300, 0, 100, 10.0)
     model = FloodModel(terrain, particles_with_depth(x, y, np.full(x.shape, 2.0), 10.0, KAPPA),
-                       Numerics(spacing=10.0), closed_edges=("south", "north", "west"))
+                       Numerics(particle_spacing_m=10.0), closed_edges=("south", "north", "west"))
     v0 = model.volume()
     run_until(model, 200.0)
     p = model.particles
@@ -188,7 +189,7 @@ def test_uniform_flow_in_a_sloping_channel_stays_normal():
     particles = particles_with_depth(x, y, np.full(x.shape, d0), dx, KAPPA, u=q / d0)
     inflow = Inflow([[0, 0], [0, width]], Hydrograph([0.0, 1e6], [q * width] * 2), dx, KAPPA,
                     terrain)
-    model = FloodModel(terrain, particles, Numerics(spacing=dx),
+    model = FloodModel(terrain, particles, Numerics(particle_spacing_m=dx),
                        closed_edges=("south", "north", "west"), boundaries=[inflow])
     for t in (50.0, 100.0, 150.0, 200.0):
         run_until(model, t)
@@ -208,7 +209,7 @@ def _dam_break(length, d_left, d_right, closed, dx=10.0):
     depth = np.where(x < 1000.0, d_left, d_right)
     wet = depth > 0
     return FloodModel(terrain, particles_with_depth(x[wet], y[wet], depth[wet], dx, KAPPA),
-                      Numerics(spacing=dx), closed_edges=closed)
+                      Numerics(particle_spacing_m=dx), closed_edges=closed)
 
 
 def _profile(model, xq):
@@ -252,7 +253,7 @@ def test_sink_absorbs_and_counts_the_water_that_reaches_it():
     d = np.where(x < 300, 5.0, 0.0)
     sink = Sink([[700, -10], [1100, -10], [1100, 50], [700, 50]], terrain, reach=4 * KAPPA * dx)
     model = FloodModel(terrain, particles_with_depth(x[d > 0], y[d > 0], d[d > 0], dx, KAPPA),
-                       Numerics(spacing=dx), boundaries=[sink])
+                       Numerics(particle_spacing_m=dx), boundaries=[sink])
     v0 = model.volume()
     run_until(model, 120.0)
     p = model.particles

@@ -3,7 +3,8 @@
 import numpy as np
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics
 from floodsph.particles import ParticleSet
 from floodsph.terrain import Terrain
 
@@ -25,7 +26,7 @@ def stretched_lake(stretch, slope, dx=10.0, kappa=Numerics.kappa, patch=None):
     p = ParticleSet(x.size)
     p.append(x=x, y=y, m=RHO_WATER * d * stretch * dx * dx, rho=RHO_WATER * d,
              h=np.full(x.size, kappa * dx * np.sqrt(stretch)))
-    return FloodModel(terrain, p, Numerics(spacing=dx, kappa=kappa))
+    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx, kappa=kappa))
 
 
 def test_the_pressure_force_on_a_stretched_lattice_is_the_depth_gradient():

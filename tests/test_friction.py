@@ -5,6 +5,7 @@ import pytest
 from sph_cases import model_on
 
 from floodsph.constants import GRAVITY, RHO_WATER
+from floodsph.numerics import TimeStepping
 from floodsph.sph import forces
 
 N, D = 0.05, 0.2  # Manning n [s m-1/3], depth [m]
@@ -26,7 +27,7 @@ def test_a_steady_kick_and_friction_settle_at_the_manning_speed_for_any_step(bet
     assert u == pytest.approx(u_e, rel=1e-9)
 
 
-@pytest.mark.parametrize("stepping", ["global", "local"])
+@pytest.mark.parametrize("stepping", list(TimeStepping))
 def test_sheet_flow_down_a_plane_reaches_the_manning_normal_speed(stepping):
     """A 0.2 m sheet on a 1 % slope, n = 0.05, between channel walls: in its middle the flow
     is uniform and, after 40 s (six relaxation times u_e / (g S)), runs at Manning's normal speed
@@ -54,5 +55,5 @@ def test_sheet_flow_down_a_plane_reaches_the_manning_normal_speed(stepping):
     assert np.abs(d_mid - D).max() < 0.01 * D  # the middle is still uniform
     assert np.abs(p.u[middle] / u_normal - 1.0).max() < 0.02
     assert np.abs(p.v[middle]).max() < 0.01
-    if stepping == "local":
+    if stepping is TimeStepping.LOCAL:
         assert np.all(p.stride[middle] == 8)

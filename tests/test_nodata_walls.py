@@ -8,7 +8,8 @@ from floodsph.boundaries import nodata_walls as nw
 from floodsph.boundaries.openings import cut_openings
 from floodsph.constants import RHO_WATER
 from floodsph.initial import seed_particles, wet_cells
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics
 from floodsph.sph import walls as wallmod
 from floodsph.terrain import Terrain
 
@@ -163,7 +164,8 @@ def lake_model(slivers=True):
     wet = wet_cells(terrain, walled=slivers)
     p = seed_particles(terrain, np.where(wet, 2.0, 0.0), 5.0, Numerics.kappa, wet=wet)
     volume = float(np.sum(p.m[:p.n]) / RHO_WATER)
-    return terrain, FloodModel(terrain, p, Numerics(spacing=5.0), closed_edges=True), volume
+    model = FloodModel(terrain, p, Numerics(particle_spacing_m=5.0), closed_edges=True)
+    return terrain, model, volume
 
 
 def test_the_slivers_inside_the_walls_are_seeded_and_bring_the_water_up_to_them():

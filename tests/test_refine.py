@@ -13,9 +13,10 @@ import pytest
 from floodsph import verification as cases
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import SMOOTHING_EXCESS, Numerics, NumericsError, Refinement
 from floodsph.output.rasterise import interpolate
-from floodsph.refinement import Refinement, Refiner
+from floodsph.refinement import Refiner
 from floodsph.sph import refine
 from floodsph.sph.kernels import SIGMA_2D, w_cubic
 from floodsph.terrain import Terrain
@@ -37,7 +38,19 @@ def jittered_pond(depth, size=30.0, dx=1.0, jitter=0.15, seed=1, u=0.0, v=0.0):
     uu = u(x, y) if callable(u) else u
     vv = v(x, y) if callable(v) else v
     p = particles_with_depth(x, y, d, dx, 1.3, u=uu, v=vv)
-    return FloodModel(terrain, p, Numerics(spacing=dx, kappa=1.3))
+    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx, kappa=1.3))
+
+
+def make_refiner(spacing: float, **settings) -> Refiner:
+    """The Refiner of ``Numerics(particle_spacing_m=spacing, **settings)``."""
+    return Refiner(Numerics(particle_spacing_m=spacing, **settings))
+
+
+def split_only(**settings) -> Refiner:
+    """A split-only Refiner at 1 m spacing that splits particles above half the lattice area
+    (``settings`` override)."""
+    return make_refiner(1.0, **{"refinement": Refinement.SPLIT, "refine_area_max": 0.5,
+                                "refine_area_min": 0.05, **settings})
 
 
 def totals(p):
@@ -58,13 +71,15 @@ def solve_in_place(model):
 
 # -- settings ------------------------------------------------------------------------------------
 def test_settings_reject_thresholds_without_hysteresis():
-    with pytest.raises(InputError, match=r"area_min < area_max / 2.*area_min=1\.5, area_max=2"):
-        Refinement(area_max=2.0, area_min=1.5)
-    with pytest.raises(InputError, match=r"numerics.refinement: 'coarsen' is not one of"):
-        Refinement(mode="coarsen")
-    assert Refiner.from_settings("none", 10.0) is None
-    r = Refiner.from_settings("split", 10.0)
-    assert r.area_max == pytest.approx(2.0 * 100.0) and not r.settings.coalesces
+    with pytest.raises(InputError, match=r"numerics.refine_area_min: must be below "
+                                         r"refine_area_max / 2 = 1 .*got 1\.5"):
+        Numerics(refine_area_max=2.0, refine_area_min=1.5)
+    with pytest.raises(NumericsError, match=r"numerics.refinement: expected a "
+                                            r"floodsph.numerics.Refinement .*got 'coarsen'"):
+        Numerics(refinement="coarsen")
+    assert Refiner.of(Numerics(particle_spacing_m=10.0, refinement=Refinement.NONE)) is None
+    r = Refiner.of(Numerics(particle_spacing_m=10.0, refinement=Refinement.SPLIT))
+    assert r.area_max == pytest.approx(2.0 * 100.0) and not r.numerics.refinement.coalesces
 
 
 # -- splitting -----------------------------------------------------------------------------------
@@ -72,7 +87,7 @@ def test_each_split_conserves_mass_and_momentum():
     model = jittered_pond(lambda x, y: 0.5 + 0.02 * x, u=lambda x, y: 1.0 + 0.1 * y,
                           v=lambda x, y: -0.5 + 0.05 * x)
     p = model.particles
-    refiner = Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0)
+    refiner = split_only()
     parents = refiner.split_candidates(model)
     interior = parents[(p.x[parents] > 3) & (p.x[parents] < 27)]
     m_p, mu_p, mv_p = p.m[interior].copy(), (p.m * p.u)[interior], (p.m * p.v)[interior]
@@ -104,8 +119,7 @@ def test_split_keeps_the_depth_of_uniform_water():
         model = model_on(flat, (0, 40), (0, 40), 1.0, 1.0, 1.0)
         p = model.particles
         parents = np.flatnonzero(np.hypot(p.x - centre, p.y - centre) < radius)
-        Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0).execute(
-            model, parents, [], [])
+        split_only().execute(model, parents, [], [])
         solve_in_place(model)
         born = p.level > 0
         assert born.sum() == 7 * parents.size
@@ -119,10 +133,10 @@ def test_no_split_across_a_wall_or_below_d_min_or_beyond_max_level():
     wall_x = 10.3  # particles at x = 9.5 and 10.5 sit 0.8 and 0.2 m from the wall
     d = np.where(y < 10.0, 1.0, 0.005)  # the north half is thinner than d_min = 0.01 m
     p = particles_with_depth(x, y, d, 1.0, 1.3)
-    model = FloodModel(terrain, p, Numerics(spacing=1.0, kappa=1.3),
+    model = FloodModel(terrain, p, Numerics(particle_spacing_m=1.0, kappa=1.3),
                        walls=[np.array([[wall_x, 0.0], [wall_x, 20.0]])])
     p = model.particles
-    refiner = Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05, max_level=1), 1.0)
+    refiner = split_only(refine_max_level=1)
     parents = refiner.split_candidates(model)
     hexagon = refine.EPS * p.h[parents]
     assert np.all(np.abs(p.x[parents] - wall_x) > hexagon)
@@ -159,8 +173,8 @@ def test_merged_h_satisfies_the_kernel_identity():
 def test_each_merge_conserves_mass_and_momentum():
     model = jittered_pond(1.0, u=lambda x, y: 0.3 + 0.01 * y, v=lambda x, y: 0.1 - 0.01 * x)
     p = model.particles
-    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0, depth_jump=0.2),
-                      1.0)
+    refiner = make_refiner(1.0, refine_area_max=20.0, refine_area_min=2.0, refine_no_merge_steps=0,
+                           refine_depth_jump=0.2)
     a, b = refiner.merge_pairs(model)
     assert a.size > 50
     assert len(set(a) | set(b)) == 2 * a.size  # each particle in one pair at most
@@ -183,7 +197,7 @@ def test_merge_keeps_the_depth_at_the_merged_position():
     def depth(x, y):
         return 1.0 + 0.002 * x
 
-    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0), 1.0)
+    refiner = make_refiner(1.0, refine_area_max=20.0, refine_area_min=2.0, refine_no_merge_steps=0)
     model = jittered_pond(depth)
     a, b = refiner.merge_pairs(model)
     p = model.particles
@@ -214,7 +228,7 @@ def pond_with_small_particles(fraction, at):
     p.m[q.n:] *= fraction
     p.h[q.n:] = p.h0[q.n:] = 1.3 * math.sqrt(fraction)  # the lattice h of their area
     p.u[q.n:], p.v[q.n:] = 0.2, -0.1
-    model = FloodModel(base.terrain, p, Numerics(spacing=1.0, kappa=1.3))
+    model = FloodModel(base.terrain, p, Numerics(particle_spacing_m=1.0, kappa=1.3))
     small = np.flatnonzero(np.isin(model.particles.pid, np.arange(q.n, p.n)))
     return model, small
 
@@ -228,7 +242,7 @@ def test_a_small_particle_among_large_ones_is_absorbed_by_its_nearest():
     at = np.array([[10.3, 12.6], [20.4, 8.2]])
     model, small = pond_with_small_particles(0.1, at)
     p = model.particles
-    refiner = Refiner(Refinement(area_max=2.0, area_min=0.8, no_merge_steps=0), 1.0)
+    refiner = make_refiner(1.0, refine_area_max=2.0, refine_area_min=0.8, refine_no_merge_steps=0)
     a, b = refiner.merge_pairs(model)  # the lattice's areas are 0.85-1.15: no candidates
     assert sorted(a) == sorted(small)
     for t, partner in zip(a, b, strict=True):
@@ -255,9 +269,9 @@ def test_a_small_particle_is_not_absorbed_where_the_merged_one_would_split():
     """Absorption keeps the hysteresis: no absorber whose merged area would reach
     2 area_min (here 0.1 + 1.0 against 2 x 0.5), and none across a velocity jump."""
     model, small = pond_with_small_particles(0.1, np.array([[10.3, 12.6]]))
-    tight = Refiner(Refinement(area_max=2.0, area_min=0.5, no_merge_steps=0), 1.0)
+    tight = make_refiner(1.0, refine_area_max=2.0, refine_area_min=0.5, refine_no_merge_steps=0)
     assert tight.merge_pairs(model)[0].size == 0
-    loose = Refiner(Refinement(area_max=2.0, area_min=0.8, no_merge_steps=0), 1.0)
+    loose = make_refiner(1.0, refine_area_max=2.0, refine_area_min=0.8, refine_no_merge_steps=0)
     assert loose.merge_pairs(model)[0].tolist() == small.tolist()
     model.particles.u[small] = 1.6  # against 0.5 sqrt(g d) = 1.57 m/s in 1 m of still water
     assert loose.merge_pairs(model)[0].size == 0
@@ -266,15 +280,15 @@ def test_a_small_particle_is_not_absorbed_where_the_merged_one_would_split():
 def test_no_merge_near_walls_across_jumps_or_of_newborns():
     model = jittered_pond(lambda x, y: np.where(x < 15.0, 1.0, 0.7))
     p = model.particles
-    refiner = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=0, depth_jump=0.2),
-                      1.0)
+    refiner = make_refiner(1.0, refine_area_max=20.0, refine_area_min=2.0, refine_no_merge_steps=0,
+                           refine_depth_jump=0.2)
     a, b = refiner.merge_pairs(model)
     protected = model.protected(p.x, p.y, p.h)
     assert not protected[a].any() and not protected[b].any()
     assert protected.any()
     d_a, d_b = p.rho[a], p.rho[b]
     assert np.all(np.abs(d_a - d_b) <= 0.2 * np.maximum(d_a, d_b))
-    patient = Refiner(Refinement(area_max=20.0, area_min=2.0, no_merge_steps=10), 1.0)
+    patient = make_refiner(1.0, refine_area_max=20.0, refine_area_min=2.0, refine_no_merge_steps=10)
     assert patient.merge_pairs(model)[0].size == 0  # all born at step 0, now step 0
 
 
@@ -291,10 +305,9 @@ def test_split_then_merge_operators_create_no_spurious_velocity():
     p = model.particles
     p.u[:], p.v[:] = 1.3, -0.4
     n0, mass0 = p.n, p.m.sum()
-    Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0).execute(
-        model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
+    split_only().execute(model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
     assert p.n > n0
-    merger = Refiner(Refinement(area_max=3.0, area_min=0.3, no_merge_steps=0), 1.0)
+    merger = make_refiner(1.0, refine_area_max=3.0, refine_area_min=0.3, refine_no_merge_steps=0)
     merges = 0
     for _ in range(10):
         a, b = merger.merge_pairs(model)
@@ -313,9 +326,8 @@ def pond_after_split_and_merge():
     end of the merging)."""
     model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
     p = model.particles
-    splitter = Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0)
-    splitter.execute(model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
-    merger = Refiner(Refinement(area_max=3.0, area_min=0.3, no_merge_steps=0), 1.0)
+    split_only().execute(model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
+    merger = make_refiner(1.0, refine_area_max=3.0, refine_area_min=0.3, refine_no_merge_steps=0)
     merges = 0
     for _ in range(30):
         model.step()
@@ -350,7 +362,7 @@ def test_split_then_merge_in_still_water_no_spurious_velocity_above_1mm_s(
 # -- in a run ------------------------------------------------------------------------------------
 def test_splitting_improves_a_coarse_dam_break():
     plain = cases.ritter(20.0)
-    r = cases.ritter(20.0, refinement=Refinement())
+    r = cases.ritter(20.0, refinement=Refinement.SPLIT_COALESCE)
     assert r.splits > 0
     assert r.particles_max >= 250 + 6 * r.splits - 7 * r.merges
     assert r.mass_error_rel < 1e-12
@@ -369,7 +381,7 @@ def test_the_thin_front_of_a_refined_dam_break_keeps_below_the_riemann_bound():
 
     model = cases._lattice_model(flat, (0, 2000), (0, 100), 10.0,
                                  lambda x, y: np.where(x < 1000, 10.0, 0.0), 5.0, 1.3,
-                                 refinement=Refinement())
+                                 refinement=Refinement.SPLIT_COALESCE)
     fastest = 0.0
     while model.t < 40.0 - 1e-9:
         model.step(40.0 - model.t)
@@ -385,22 +397,21 @@ def test_refined_dam_break_matches_the_fine_uniform_run_at_a_third_of_the_cost()
     channel's north wall lies 3.6 m beyond the last lattice row, not half a spacing; before its
     seeds were settled (``floodsph.wall_seeding``) the uniform run's L1 was 1.83 %."""
     fine = cases.ritter(10.0 / math.sqrt(7.0))
-    r = cases.ritter(10.0, refinement=Refinement(max_level=1))
+    r = cases.ritter(10.0, refinement=Refinement.SPLIT_COALESCE, refine_max_level=1)
     assert r.splits > 0 and r.mass_error_rel < 1e-12
     assert r.l1 <= 1.4 * fine.l1
     assert r.particle_steps <= fine.particle_steps / 3
 
 
 def test_split_daughters_relax_to_sqrt3_lattice_smoothing_and_lattice_particles_stay():
-    from floodsph.refinement import RELAX_RATE, SMOOTHING_EXCESS, relax_smoothing
+    from floodsph.refinement import RELAX_RATE, relax_smoothing
 
     model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
     p = model.particles
     h0_lattice = p.h0[0]
     assert np.all(p.h0 == h0_lattice)
     kappa = model.numerics.kappa
-    Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0).execute(
-        model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.0), [], [])
+    split_only().execute(model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.0), [], [])
     daughters = p.level > 0
     c0 = p.h0**2 * p.rho0
     target = SMOOTHING_EXCESS * kappa**2 * p.m
@@ -426,8 +437,6 @@ def test_split_daughters_relax_to_sqrt3_lattice_smoothing_and_lattice_particles_
 def test_a_parent_passes_on_at_most_its_relaxed_smoothing():
     """Daughters take 0.9 h_p, with h_p at most the relaxed sqrt(3) kappa sqrt(m_p / rho_p):
     an unrelaxed edge parent does not hand its inflated h down a generation."""
-    from floodsph.refinement import SMOOTHING_EXCESS
-
     model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
     p = model.particles
     kappa = model.numerics.kappa
@@ -437,15 +446,14 @@ def test_a_parent_passes_on_at_most_its_relaxed_smoothing():
     relaxed = math.sqrt(SMOOTHING_EXCESS) * kappa * np.sqrt(p.m / p.rho)
     expect = refine.H_FACTOR * np.concatenate([relaxed[inflated], p.h[plain]])
     n0 = p.n - 4
-    Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05), 1.0).execute(
-        model, np.concatenate([inflated, plain]), [], [])
+    split_only().execute(model, np.concatenate([inflated, plain]), [], [])
     born_h = p.h[n0:].reshape(4, refine.DAUGHTERS)
     np.testing.assert_allclose(born_h, np.repeat(expect[:, None], refine.DAUGHTERS, axis=1),
                                rtol=1e-12)
 
 
 def test_the_refiner_relaxes_and_bounds_smoothing_to_its_own_smoothing_excess():
-    """Refinement.smoothing_excess (here 2, default 3) sets both the h a parent passes on,
+    """Numerics.refine_smoothing_excess (here 2, default 3) sets both the h a parent passes on,
     0.9 min(h_p, sqrt(2) kappa sqrt(m_p / rho_p)), and the daughters' relaxed h^2 rho."""
     model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
     p = model.particles
@@ -454,15 +462,13 @@ def test_the_refiner_relaxes_and_bounds_smoothing_to_its_own_smoothing_excess():
     p.h[centre] *= 3.0
     bound = math.sqrt(2.0) * kappa * np.sqrt(p.m[centre] / p.rho[centre])
     n0 = p.n - centre.size
-    refiner = Refiner(Refinement(mode="split", area_max=0.5, area_min=0.05,
-                                 smoothing_excess=2.0), 1.0)
+    refiner = split_only(refine_smoothing_excess=2.0)
     refiner.execute(model, centre, [], [])
     np.testing.assert_allclose(p.h[n0:].reshape(-1, refine.DAUGHTERS),
                                np.repeat(refine.H_FACTOR * bound[:, None], refine.DAUGHTERS,
                                          axis=1), rtol=1e-12)
     daughters = p.level > 0
-    relaxer = Refiner(Refinement(mode="split", area_max=1e9, area_min=0.05,
-                                 smoothing_excess=2.0), 1.0)  # no further splits
+    relaxer = split_only(refine_area_max=1e9, refine_smoothing_excess=2.0)  # no further splits
     for step in range(1, 61):
         model.steps = step  # Refiner.apply relaxes once per model step
         assert relaxer.apply(model) == (0, 0)
@@ -471,8 +477,9 @@ def test_the_refiner_relaxes_and_bounds_smoothing_to_its_own_smoothing_excess():
 
 
 def test_a_smoothing_excess_below_the_lattice_value_is_refused():
-    with pytest.raises(InputError, match="smoothing_excess"):
-        Refinement(smoothing_excess=0.9)
+    with pytest.raises(InputError, match="numerics.refine_smoothing_excess: must be >= 1, "
+                                         "got 0.9"):
+        Numerics(refine_smoothing_excess=0.9)
 
 
 def test_a_small_particle_beside_a_large_one_still_finds_its_merge_partner():

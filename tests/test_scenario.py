@@ -8,10 +8,10 @@ import pytest
 from conftest import BASE_SCENARIO, X0, Y0
 
 from floodsph.errors import InputError
+from floodsph.numerics import Refinement
 from floodsph.scenario import (
     Edges,
     OutputFormat,
-    Refinement,
     load_scenario,
     write_resolved,
 )
@@ -185,13 +185,22 @@ def test_missing_required_tables(write_scenario):
     )
 
 
-def test_hydrograph_is_read_at_load(write_scenario, tmp_path):
+def test_a_bad_hydrograph_is_refused_with_the_inputs_naming_file_key_and_line(write_scenario,
+                                                                              tmp_path):
+    """The scenario checks that the CSV exists; the inputs read it, once, before any run
+    folder is touched."""
+    from floodsph.inputs import prepare_inputs
+
     (tmp_path / "q.csv").write_text("time_s,discharge_m3s\n0,0\n10,5\n5,1\n")
     text = BASE_SCENARIO + f"[[inflows]]\nline = [[{X0}, {Y0}], [{X0}, {Y0 + 50}]]\n" \
         'hydrograph = "q.csv"\n'
-    message = error_of(write_scenario, text)
-    assert message.startswith(f"{tmp_path / 'scenario.toml'}: inflows[0].hydrograph: ")
-    assert "line 4" in message and "times must increase strictly" in message
+    scenario = load_scenario(write_scenario(text))
+    with pytest.raises(InputError) as err:
+        prepare_inputs(scenario)
+    message = str(err.value)
+    assert message.startswith(f"scenario.toml: inflows[0].hydrograph: {tmp_path / 'q.csv'}, "
+                              "line 4: ")
+    assert "times must increase strictly" in message
 
 
 def test_refinement_thresholds_reach_the_refiner(write_scenario):
@@ -208,8 +217,8 @@ def test_refinement_thresholds_reach_the_refiner(write_scenario):
     spacing = inputs.spacing_m
     assert refiner.area_max == pytest.approx(3.0 * spacing**2)
     assert refiner.area_min == pytest.approx(0.5 * spacing**2)
-    assert (refiner.settings.d_min, refiner.settings.max_level) == (0.05, 2)
-    assert refiner.settings.coalesces
+    assert (refiner.numerics.refine_d_min_m, refiner.numerics.refine_max_level) == (0.05, 2)
+    assert refiner.numerics.refinement is Refinement.SPLIT_COALESCE
 
 
 def test_closed_sides_are_walls_and_the_other_sides_open(write_scenario):

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from sph_cases import model_on, particles_with_depth, run_until
 
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics
 from floodsph.output.rasterise import interpolate
 from floodsph.terrain import Terrain
 
@@ -31,7 +32,7 @@ def test_momentum_changes_only_through_external_forces():
     d = 2.0 + 0.5 * rng.random(x.size)
     p = particles_with_depth(x, y, d, 8.0, 1.3, u=rng.normal(0, 1, x.size) + 2.0,
                              v=rng.normal(0, 1, x.size) - 1.0)
-    model = FloodModel(terrain, p, Numerics(spacing=8.0, kappa=1.3), closed_edges=False)
+    model = FloodModel(terrain, p, Numerics(particle_spacing_m=8.0, kappa=1.3), closed_edges=False)
     mom0 = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     scale = (p.m * np.hypot(p.u, p.v)).sum()
     run_until(model, 20.0)

@@ -9,7 +9,7 @@ import pytest
 
 from floodsph import testing as exact
 from floodsph import verification as cases
-from floodsph.refinement import Refinement
+from floodsph.numerics import Refinement
 
 
 def test_ritter_dam_break_coarse():
@@ -69,7 +69,7 @@ def test_ritter_convergence_meets_targets():
                    "only at 5 m); the targets lie within the split-and-merge noise "
                    "(workflows/ritter_sensitivity.py)")
 def test_refined_ritter_convergence_meets_targets():
-    results = [cases.ritter(dx, refinement=Refinement()) for dx in (10.0, 5.0, 2.5)]
+    results = [cases.ritter(dx, refinement=Refinement.SPLIT_COALESCE) for dx in (10.0, 5.0, 2.5)]
     errors = [r.l1 for r in results]
     assert results[1].l1 <= 0.015
     assert exact.observed_order(errors, [10.0, 5.0, 2.5]) >= 0.8
@@ -81,7 +81,7 @@ def test_refined_ritter_at_5m_beats_the_uniform_run():
     """Splitting resolves the thin front: at 5 m the L1 error meets the 1.5 % target
     (measured 0.57 %, uniform 0.96 %) and the front is within 2 spacings (3 m ahead,
     uniform 17 m behind)."""
-    r = cases.ritter(5.0, refinement=Refinement())
+    r = cases.ritter(5.0, refinement=Refinement.SPLIT_COALESCE)
     assert r.mass_error_rel < 1e-12 and r.splits > 0 and r.merges > 0
     assert r.l1 <= 0.015
     assert abs(r.front_error_m) <= 2 * 5.0

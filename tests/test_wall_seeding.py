@@ -10,7 +10,8 @@ from sph_cases import lattice, model_on, run_until
 
 from floodsph import wall_seeding
 from floodsph.constants import RHO_WATER
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics
 from floodsph.sph import walls as wallmod
 
 STILL = load_workflow("still_water_at_walls",

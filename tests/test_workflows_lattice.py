@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from conftest import load_workflow
 
-from floodsph.model import Numerics
+from floodsph.numerics import Numerics
 
 lattice = load_workflow("lattice_stability",
                         Path(__file__).resolve().parents[1] / "workflows" / "lattice_stability.py")

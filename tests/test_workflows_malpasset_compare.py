@@ -88,11 +88,11 @@ def test_breach_variants_scale_froehlich_width_and_time(tmp_path, write_scenario
     width = 0.27 * 1.3 * 2.0e6 ** 0.32 * 12.0 ** 0.04
     t_f = 63.2 * math.sqrt(2.0e6 / (9.81 * 12.0 ** 2))
     for factor in (0.5, 1.5):
-        w = loaded[f"breach_width_x{factor:g}"].inflows[0].breach.parameters
-        t = loaded[f"formation_time_x{factor:g}"].inflows[0].breach.parameters
-        assert w["average_width_m"] == pytest.approx(factor * width, rel=1e-12)
-        assert "formation_time_s" not in w
-        assert t["formation_time_s"] == pytest.approx(factor * t_f, rel=1e-12)
+        w = loaded[f"breach_width_x{factor:g}"].inflows[0].breach
+        t = loaded[f"formation_time_x{factor:g}"].inflows[0].breach
+        assert w.average_width_m == pytest.approx(factor * width, rel=1e-12)
+        assert w.formation_time_s is None
+        assert t.formation_time_s == pytest.approx(factor * t_f, rel=1e-12)
     assert loaded["manning_x0.8"].terrain.manning == pytest.approx(0.024, rel=1e-12)
     # The level variant raises the reservoir (the higher body) only, not the tail water.
     levels = [w.level_m for w in loaded["level_+1m"].initial_water]

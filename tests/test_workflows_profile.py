@@ -9,7 +9,8 @@ import pytest
 from conftest import load_workflow
 from sph_cases import model_on
 
-from floodsph.refinement import Refinement, Refiner
+from floodsph.numerics import Numerics
+from floodsph.refinement import Refiner
 from floodsph.sph import neighbours
 
 REPO = Path(__file__).resolve().parents[1]
@@ -22,7 +23,8 @@ def test_stage_times_are_exclusive_and_add_up_to_the_wall_time():
     the wall time; the list-build counter is removed afterwards."""
     model = model_on(lambda x, y: 0 * x, (0, 40), (0, 24), 1.0,
                      lambda x, y: np.where(x < 12.0, 1.0, 0.0), 1.0)
-    model.refiner = Refiner(Refinement(area_max=2.0, area_min=0.9), 1.0)
+    model.refiner = Refiner(Numerics(particle_spacing_m=1.0, refine_area_max=2.0,
+                                     refine_area_min=0.9))
     build = neighbours.NeighbourList.__init__
     rows, totals = prof.profile(model, steps=40, warmup=1)
     assert neighbours.NeighbourList.__init__ is build

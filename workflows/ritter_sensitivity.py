@@ -1,7 +1,7 @@
 """How the refined Ritter convergence study depends on the daughters' relaxed smoothing.
 
 Runs ``floodsph.verification.ritter`` (d0 = 10 m, t = 50 s) at 10, 5 and 2.5 m with
-``split+coalesce`` (or ``--mode split``) for each value of ``Refinement.smoothing_excess``
+``split+coalesce`` (or ``--mode split``) for each value of ``Numerics.refine_smoothing_excess``
 (split particles relax to h^2 rho = smoothing_excess kappa^2 m), and checks each row against
 the targets of issue 2:
 
@@ -35,10 +35,11 @@ from floodsph import testing as exact
 from floodsph import verification as cases
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics, Refinement
 from floodsph.output.tables import markdown
 from floodsph.particles import ParticleSet
-from floodsph.refinement import Refinement, Refiner
+from floodsph.refinement import Refiner
 from floodsph.terrain import Terrain
 
 L1_AT_5M = 0.015
@@ -52,7 +53,7 @@ def _still_lake(size, dx, d0, x, y, area, h) -> FloodModel:
     terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, size[0]), (0, size[1]), dx)
     p = ParticleSet(x.size)
     p.append(x=x, y=y, m=RHO_WATER * d0 * area, rho=np.full(x.size, RHO_WATER * d0), h=h)
-    return FloodModel(terrain, p, Numerics(spacing=dx))
+    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx))
 
 
 def split_column_dipole(d0: float = 4.0, dx: float = 10.0) -> dict:
@@ -63,8 +64,8 @@ def split_column_dipole(d0: float = 4.0, dx: float = 10.0) -> dict:
                         np.full(X.size, Numerics.kappa * dx))
     p = model.particles
     column = np.flatnonzero((np.abs(p.x - 205.0) < 1.0) & (p.y > 40.0) & (p.y < 160.0))
-    Refiner(Refinement(mode="split", area_max=0.5, area_min=0.2), dx).execute(
-        model, column, [], [])
+    Refiner(Numerics(particle_spacing_m=dx, refinement=Refinement.SPLIT, refine_area_max=0.5,
+                     refine_area_min=0.2)).execute(model, column, [], [])
     model.step(1e-9)  # neighbour lists and the density solve, the particles all but unmoved
     d = p.rho / RHO_WATER
     middle = np.abs(p.y - 100.0) < 20.0
@@ -108,7 +109,7 @@ def resolution_interface_dipole(d0: float = 5.0, dx: float = 5.0) -> dict:
 
 def study(excess: float, mode: str, spacings: list[float]) -> dict:
     """One convergence study: the row of the table for ``smoothing_excess = excess``."""
-    results = [cases.ritter(dx, refinement=Refinement(mode=mode, smoothing_excess=excess))
+    results = [cases.ritter(dx, refinement=Refinement(mode), refine_smoothing_excess=excess)
                for dx in spacings]
     l1 = [r.l1 for r in results]
     order = exact.observed_order(l1, spacings)
@@ -139,7 +140,7 @@ def main(argv=None) -> int:
         ap.error(f"--spacings: an observed order needs two spacings or more, got {args.spacings}")
     for excess in args.excess:
         try:
-            Refinement(mode=args.mode, smoothing_excess=excess)
+            Numerics(refinement=Refinement(args.mode), refine_smoothing_excess=excess)
         except InputError as err:
             ap.error(f"--excess: {err}")
     dipole = split_column_dipole()

@@ -26,7 +26,8 @@ def variant(path: Path, out: Path, mode: str | None = None, spacing: float | Non
     [s]; ``settings``: ``[numerics]`` refinement keys (:data:`REFINE_KEYS`);
     ``time_stepping``: ``numerics.time_stepping`` (``"global"`` or ``"local"``).
     """
-    from floodsph.scenario import Refinement, TimeStepping, load_scenario
+    from floodsph.numerics import Refinement, TimeStepping
+    from floodsph.scenario import load_scenario
 
     scenario = load_scenario(path)
     numerics = dict(settings or {})

@@ -55,7 +55,8 @@ import scenario_runs as runs  # noqa: E402
 
 from floodsph import verification as cases  # noqa: E402
 from floodsph.constants import RHO_WATER  # noqa: E402
-from floodsph.model import FloodModel, Numerics  # noqa: E402
+from floodsph.model import FloodModel  # noqa: E402
+from floodsph.numerics import Numerics, Refinement, TimeStepping  # noqa: E402
 from floodsph.output.tables import markdown, write_csv  # noqa: E402
 from floodsph.particles import ParticleSet  # noqa: E402
 from floodsph.terrain import Terrain  # noqa: E402
@@ -83,7 +84,7 @@ def block_model(kind: str, n_side: int, dx: float = 5.0, **numerics) -> FloodMod
     p = ParticleSet(X.size)
     p.append(x=X.ravel(), y=Y.ravel(), m=np.full(X.size, RHO_WATER * depth * dx * dx),
              rho=np.full(X.size, RHO_WATER * depth), h=np.full(X.size, Numerics.kappa * dx))
-    return FloodModel(terrain, p, Numerics(spacing=dx, **numerics))
+    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx, **numerics))
 
 
 def throughput(kind: str, n_side: int = BLOCK_SIDE, steps: int = 10, repeats: int = 3,
@@ -137,13 +138,13 @@ def main(argv=None) -> None:
     if not args.throughput_only:
         names = [c for c in args.cases if c in ANALYTIC]
         if names:  # compile every kernel once, outside the timings
-            cases.ritter(20.0, refinement=_refinement("split+coalesce"))
+            cases.ritter(20.0, refinement=Refinement.SPLIT_COALESCE)
         for name in names:
             for dx in (QUICK if args.quick else SPACINGS)[name]:
                 for mode in args.modes:
                     for stepping in args.time_stepping:
-                        rows.append(cases.CASES[name](dx, refinement=_refinement(mode),
-                                                      time_stepping=stepping))
+                        rows.append(cases.CASES[name](dx, refinement=Refinement(mode),
+                                                      time_stepping=TimeStepping(stepping)))
                         print_row(rows[-1])
         for name in (c for c in args.cases if c in REAL):
             real += real_case(name, out / name, args.modes, args.quick, args.max_steps,
@@ -167,13 +168,6 @@ def main(argv=None) -> None:
     picture = plot(out / "speed_vs_error.png", analytic, real)
     (out / "speed_vs_error.md").write_text(report(analytic, real, speed, picture, argv))
     print(f"report: {out / 'speed_vs_error.md'}")
-
-
-def _refinement(mode: str):
-    """The ``Refinement`` of a mode (None for uniform resolution)."""
-    from floodsph.refinement import Refinement
-
-    return None if mode == "none" else Refinement(mode=mode)
 
 
 def real_scenario(case: str, out: Path) -> Path | None:

@@ -34,7 +34,8 @@ from matplotlib.path import Path
 
 from floodsph import verification, wall_seeding
 from floodsph.constants import RHO_WATER
-from floodsph.model import FloodModel, Numerics
+from floodsph.model import FloodModel
+from floodsph.numerics import Numerics
 from floodsph.particles import ParticleSet
 from floodsph.terrain import Terrain
 
@@ -62,7 +63,7 @@ def lattice_lake(size, depth, dx, polyline, inside: bool) -> FloodModel:
              rho=np.full(n, RHO_WATER * depth), h=np.full(n, Numerics.kappa * dx))
     cells = (int(round(size[1] / 5.0)), int(round(size[0] / 5.0)))
     terrain = Terrain(np.zeros(cells), 5.0, 5.0, manning=0.0)
-    return FloodModel(terrain, p, Numerics(spacing=dx), walls=[polyline])
+    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx), walls=[polyline])
 
 
 def build(case: str) -> tuple[FloodModel, float]:

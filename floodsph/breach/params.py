@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from floodsph.breach import formulas
@@ -48,7 +48,8 @@ class BreachParams:
     start_time_s: float = 0.0
     duration_s: float | None = None
     dt_s: float | None = None
-    key: str = "breach"  # key path of the table, for error messages
+    key: str = field(default="breach", compare=False, metadata={"scenario": False})
+    """The key path of the table (with its file), prefix of error messages; no key itself."""
 
     @classmethod
     def from_mapping(cls, table, key="breach", base_dir=".", source=None):

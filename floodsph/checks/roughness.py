@@ -14,6 +14,10 @@ import numpy as np
 
 from floodsph.errors import InputError, warn
 
+N_DEFAULT = 0.035
+"""The Manning n [s m^-1/3] of ``terrain.manning`` when the scenario gives none, of the order
+of grass-covered floodplains (Chow 1959, table 5-6)."""
+
 N_STRICKLER = 1.0
 """n at or above this [s m^-1/3] is refused as a Strickler or Chezy coefficient."""
 

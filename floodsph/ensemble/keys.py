@@ -69,12 +69,12 @@ class KeyPath:
 def _table_keys() -> dict[str, tuple[str, ...]]:
     """The keys each scenario table accepts, by table pattern (from the scenario's classes)."""
     from floodsph.breach.params import BreachParams
+    from floodsph.numerics import SCENARIO_KEYS as NUMERICS_KEYS
     from floodsph.scenario import (
         TOP_KEYS,
         Gauges,
         Inflow,
         InitialWater,
-        NumericsConfig,
         OutputConfig,
         ScenarioInfo,
         Sink,
@@ -82,8 +82,8 @@ def _table_keys() -> dict[str, tuple[str, ...]]:
         Wall,
     )
 
-    def names(cls, drop=()):
-        return tuple(f.name for f in fields(cls) if f.name not in drop)
+    def names(cls):
+        return tuple(f.name for f in fields(cls) if f.metadata.get("scenario", True))
 
     return {
         "": TOP_KEYS,
@@ -92,10 +92,10 @@ def _table_keys() -> dict[str, tuple[str, ...]]:
         "initial_water[]": names(InitialWater),
         "walls[]": names(Wall),
         "inflows[]": names(Inflow),
-        "inflows[].breach": names(BreachParams, drop=("key",)),
+        "inflows[].breach": names(BreachParams),
         "sinks[]": names(Sink),
         "gauges": names(Gauges),
-        "numerics": names(NumericsConfig),
+        "numerics": NUMERICS_KEYS,
         "output": names(OutputConfig),
     }
 

@@ -210,14 +210,12 @@ def _check_alone(spec, base, data, binding: Binding, drawn, mid: str) -> None:
 
 def _validate(spec: EnsembleSpec, base: Scenario, data: dict) -> Scenario:
     """``data`` through the scenario's validation, and its breaches through their set-up."""
-    from floodsph.breach.params import BreachParams, resolve
+    from floodsph.breach.params import resolve
 
     scenario = scenario_from_dict(data, source=base.path.name, base_dir=spec.path.parent)
-    for i, inflow in enumerate(scenario.inflows):
+    for inflow in scenario.inflows:
         if inflow.breach is not None:
-            table = {"method": inflow.breach.method, **inflow.breach.parameters}
-            resolve(BreachParams.from_mapping(table, f"inflows[{i}].breach",
-                                              source=base.path.name))
+            resolve(inflow.breach)
     return scenario
 
 

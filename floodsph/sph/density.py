@@ -31,6 +31,7 @@ Mirror images across walls (``floodsph.sph.walls``) are part of the summation.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -213,13 +214,28 @@ def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ra
     guess (see the module docstring).
     On return every particle has rho, h and alpha consistent with its neighbours to ``tol``,
     except the unconverged, capped and held ones, which take the plain summation at their h.
-    Returns (iterations, unconverged, capped, held); ``iterations`` is the largest number of
-    summations any particle needed.
+    Returns the :class:`DensityOutcome` counts.
     """
     iters = np.ones(p.n, dtype=np.int64)  # rows not solved count as converged
     h_cap = nl.h_cap(p.x, p.y) if cap else np.full(p.n, np.inf)
     solve(nl.rows, p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked,
           wdist, *walls, seg, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, iters)
     held = iters > max_iter
-    return (int(np.abs(np.where(held, 0, iters)).max(initial=0)), int((iters < 0).sum()),
-            int((iters == 0).sum()), int(held.sum()))
+    return DensityOutcome(iterations=int(np.abs(np.where(held, 0, iters)).max(initial=0)),
+                          unconverged=int((iters < 0).sum()), capped=int((iters == 0).sum()),
+                          held=int(held.sum()))
+
+
+class DensityOutcome(NamedTuple):
+    """What :func:`solve_density` did, decoded from the per-particle code ``iters`` of
+    :func:`solve`: k > 0 converged in k summations, -k not converged in k, 0 capped at the
+    lists' reach, > max_iter held at the shrink bound."""
+
+    iterations: int
+    """The largest number of summations a converged or unconverged particle needed."""
+    unconverged: int
+    """Particles not converged to ``tol`` in ``max_iter`` (plain summation at their h)."""
+    capped: int
+    """Particles whose h was capped at what the neighbour lists hold."""
+    held: int
+    """Particles held at ``H_SHRINK_MIN`` times their guessed h."""

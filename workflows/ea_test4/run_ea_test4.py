@@ -37,8 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.numerics import Refinement
 from floodsph.output.tables import write_csv
-from floodsph.refinement import MODES as REFINEMENT_MODES
 
 REPO = Path(__file__).resolve().parents[2]
 DEM_NAMES = {5: "ea4_dem_5m.asc", 10: "ea4_dem_10m.asc"}
@@ -246,7 +246,7 @@ def main(argv=None) -> int:
     parser.add_argument("--time-stepping", choices=("global", "local"), default="global",
                         help="numerics.time_stepping: one step for all particles, or each "
                              "at its own")
-    parser.add_argument("--refinement", choices=REFINEMENT_MODES, default=None,
+    parser.add_argument("--refinement", choices=[mode.value for mode in Refinement], default=None,
                         help="numerics.refinement (default: floodsph's, split+coalesce)")
     args = parser.parse_args(argv)
 
