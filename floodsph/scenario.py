@@ -76,7 +76,8 @@ class ScenarioInfo:
 class TerrainConfig:
     """``[terrain]``: the DEM and the bed roughness (a uniform n, an n raster or land cover).
 
-    ``manning`` is None when the roughness comes from ``landcover`` (+ ``manning_table``).
+    ``manning`` is None when the roughness comes from ``landcover`` (+ ``manning_table``: a
+    CSV path, or ``"worldcover"`` for the shipped ESA WorldCover table).
     """
 
     dem: Path
@@ -84,7 +85,7 @@ class TerrainConfig:
     dem_variable: str | None = None
     manning: float | Path | None = 0.035
     landcover: Path | None = None
-    manning_table: Path | None = None
+    manning_table: Path | str | None = None
     extent: tuple[float, float, float, float] | None = None
     edges: Edges = Edges.OPEN
     closed_sides: tuple[str, ...] = ()
@@ -237,7 +238,8 @@ class Scenario:
     def input_files(self) -> tuple[Path, ...]:
         """The scenario file and every file it reads (a run never writes over them)."""
         t = self.terrain
-        files = [self.path, t.dem, t.landcover, t.manning_table,
+        files = [self.path, t.dem, t.landcover,
+                 t.manning_table if isinstance(t.manning_table, Path) else None,
                  t.manning if isinstance(t.manning, Path) else None,
                  *(w.depth for w in self.initial_water),
                  *(i.hydrograph for i in self.inflows),
@@ -403,7 +405,7 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         if manning >= N_STRICKLER:
             raise r.fail(join(p, "manning"), strickler_text(manning))
     landcover = r.existing_file(t, p, "landcover", None)
-    manning_table = r.existing_file(t, p, "manning_table", None)
+    manning_table = _manning_table(r, t, p)
     if landcover is not None and "manning" in t:
         raise r.fail(join(p, "landcover"), "give either manning or landcover, not both")
     if manning_table is not None and landcover is None:
@@ -431,6 +433,17 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         edges=edges,
         closed_sides=_closed_sides(r, t, p, edges),
     )
+
+
+def _manning_table(r: Reader, t: dict, p: str) -> Path | str | None:
+    """``terrain.manning_table``: a CSV file, or ``"worldcover"`` for the table shipped with
+    floodsph (ESA WorldCover classes, ``floodsph.io.manning``); the name wins over a file
+    of that name."""
+    from floodsph.io.manning import WORLDCOVER
+
+    if t.get("manning_table") == WORLDCOVER:
+        return WORLDCOVER
+    return r.existing_file(t, p, "manning_table", None)
 
 
 SIDES = ("west", "east", "south", "north")
@@ -593,7 +606,7 @@ def _output(r: Reader, data: dict) -> OutputConfig:
 
 def write_resolved(scenario: Scenario, path: Path) -> None:
     """Write the resolved scenario (absolute paths, defaults filled) as TOML to ``path``."""
-    from floodsph.toml_writer import dumps
+    from tomli_w import dumps
 
     header = (
         f"# Resolved copy of {scenario.path}\n"
