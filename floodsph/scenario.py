@@ -493,8 +493,7 @@ def _initial_water(r: Reader, t: dict, p: str) -> InitialWater:
     r.check_keys(t, p, ("level_m", "polygon", "depth", *VECTOR_KEYS))
     if "depth" in t:
         if "level_m" in t or "polygon" in t or "file" in t:
-            raise r.fail(join(p, "depth"), "give either depth or level_m + polygon (or file), "
-                                           "not both")
+            raise r.fail(join(p, "depth"), "give either depth or level_m + polygon, not both")
         r.vector_source(t, p, "depth")
         return InitialWater(depth=r.existing_file(t, p, "depth"))
     if "level_m" not in t:

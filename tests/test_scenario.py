@@ -124,7 +124,8 @@ POLY = "[[0, 0], [10, 0], [10, 10]]"
          "bogus: unknown key; allowed keys: gauges, inflows, initial_water, numerics, output, "
          "scenario, sinks, terrain, walls"),
         (("level_m = 100.0", "level_m = 100.0\ncolour = 1"),
-         "initial_water[0].colour: unknown key; allowed keys: depth, level_m, polygon"),
+         "initial_water[0].colour: unknown key; allowed keys: crs, depth, file, layer, level_m, "
+         "polygon"),
     ],
 )
 def test_bad_values_name_the_key(write_scenario, change, message):
