@@ -11,7 +11,7 @@ messages:
   polygon with holes is refused (draw the island as its own body, or leave it: ground above
   the level stays dry anyway).
 
-A features of another geometry type, or a file without any, is refused naming the file.
+A feature of another geometry type, or a file without features, is refused naming the file.
 ``[gauges]`` points come from :func:`vector_gauges`.
 """
 
