@@ -8,7 +8,9 @@ created (``floodsph check`` stops after it and prints :func:`summary_lines`):
    shapes alone (``floodsph.memory``), before any grid is allocated;
 3. load the DEM and roughness (``floodsph.io.dem.load_terrain``: fill values, feet, Manning
    values that are Strickler coefficients);
-4. check that the scenario's geometry lies on the DEM (``floodsph.checks.placement``);
+4. read the geometry given as vector files, reprojected into the DEM's CRS
+   (``floodsph.vector_inputs``), and check that all of it lies on the DEM
+   (``floodsph.checks.placement``);
 5. build the initial depth grid: the deepest of all ``[[initial_water]]`` bodies per cell
    (two overlapping still-water bodies hold the higher level, not the sum); refuse a
    scenario without water (``floodsph.checks.water``);
@@ -33,15 +35,19 @@ from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
 from floodsph.io.raster import crs_label
+from floodsph.io.vector import is_vector_file
 from floodsph.memory import MemoryEstimate, check_memory, estimate_memory, format_bytes
 from floodsph.scenario import Scenario
+from floodsph.vector_inputs import vector_gauges, with_vector_geometry
 
 
 @dataclass
 class Inputs:
     """What a run starts from (all coordinates local to the terrain's origin).
 
-    ``warnings`` lists the inputs accepted with a warning (each also logged at WARNING).
+    ``walls`` (polylines) and ``sinks`` (polygons) are (k, 2) arrays, inline ones and those
+    read from vector files alike. ``warnings`` lists the inputs accepted with a warning (each
+    also logged at WARNING).
     """
 
     terrain: object
@@ -49,6 +55,7 @@ class Inputs:
     particles: object
     spacing_m: float
     walls: list[np.ndarray]
+    sinks: list[np.ndarray]
     hydrographs: list
     gauges: object | None
     volume_initial_m3: float
@@ -83,6 +90,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         warnings=warnings,
     )
     spacing = scenario.numerics.particle_spacing_m or float(min(terrain.dx, terrain.dy))
+    scenario = with_vector_geometry(scenario, terrain)
     check_geometry_on_dem(scenario, terrain, spacing, source)
     wet = wet_cells(terrain, walled=tc.nodata_walled)
     dry: list[str] = []
@@ -101,23 +109,23 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
             f"spacing of {spacing:g} m (its depth averaged over lattice cells of that size "
             "stays below 1 mm, or the lattice does not fit on the DEM); use a finer spacing")
     gauges = None
-    if scenario.gauges is not None:
+    if scenario.gauges is not None and is_vector_file(scenario.gauges.file):
+        gauges = vector_gauges(scenario.gauges, terrain, source)
+    elif scenario.gauges is not None:
         from floodsph.output.gauges import read_gauge_file
 
         gauges = read_gauge_file(scenario.gauges.file, terrain)
     memory = _estimate(scenario, particles.n, v_in, spacing, terrain.elevation.size, out_cells,
                        lattice, read)
     check_memory(memory, source)
-    walls = [
-        np.column_stack(terrain.to_local(*np.asarray(w.polyline, dtype=np.float64).T))
-        for w in scenario.walls
-    ]
+    walls = [local_points(terrain, w.polyline) for w in scenario.walls]
     return Inputs(
         terrain=terrain,
         depth=depth,
         particles=particles,
         spacing_m=spacing,
         walls=walls,
+        sinks=[local_points(terrain, sink.polygon) for sink in scenario.sinks],
         hydrographs=hydrographs,
         gauges=gauges,
         volume_initial_m3=particles.volume(),
@@ -126,6 +134,11 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         memory=memory,
         warnings=warnings,
     )
+
+
+def local_points(terrain, points) -> np.ndarray:
+    """World points [[x, y], ...] in the DEM's CRS as a (k, 2) array of local coordinates."""
+    return np.column_stack(terrain.to_local(*np.asarray(points, dtype=np.float64).T))
 
 
 def output_cells(scenario: Scenario, shape: tuple[int, int], dx: float, dy: float) -> float:
@@ -203,17 +216,15 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
     source = str(scenario.path.name)
     depth = np.zeros(terrain.shape)
     for i, body in enumerate(scenario.initial_water):
-        where = f"{source}: initial_water[{i}]"
+        key = body.feature or f"initial_water[{i}]"
         if body.depth is not None:
-            d = depth_from_raster(terrain, body.depth, f"{where}.depth", wet)
+            d = depth_from_raster(terrain, body.depth, f"{source}: {key}.depth", wet)
             polygon = None
         else:
-            polygon = np.column_stack(
-                terrain.to_local(*np.asarray(body.polygon, dtype=np.float64).T)
-            )
-            d = depth_from_level(terrain, body.level_m, polygon, f"{where}.polygon", wet)
+            polygon = local_points(terrain, body.polygon)
+            d = depth_from_level(terrain, body.level_m, polygon, f"{source}: {key}.polygon", wet)
         if dry is not None and not np.any(d > 0.0):
-            dry.append(dry_body_reason(terrain, wet, body, polygon, f"initial_water[{i}]"))
+            dry.append(dry_body_reason(terrain, wet, body, polygon, key))
         np.maximum(depth, d, out=depth)
     return depth
 

@@ -44,7 +44,6 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 D_TYPICAL_M = 1.0
 REFINEMENT_FACTOR = {"none": 1.0, "split": 4.0, "split+coalesce": 2.0}
@@ -120,8 +119,9 @@ def estimate_memory(
 def available_memory() -> tuple[int | None, str]:
     """Bytes available to a new run and where the number comes from.
 
-    ``FLOODSPH_MEMORY_LIMIT_BYTES`` if set, else ``MemAvailable`` of ``/proc/meminfo``;
-    ``(None, ...)`` where neither exists (no check is then made).
+    ``FLOODSPH_MEMORY_LIMIT_BYTES`` if set, else the memory the operating system can give
+    without swapping (``psutil.virtual_memory().available``: ``MemAvailable`` on Linux);
+    ``(None, ...)`` where psutil cannot tell (no check is then made).
     """
     value = os.environ.get(LIMIT_ENV)
     if value:
@@ -131,12 +131,12 @@ def available_memory() -> tuple[int | None, str]:
             from floodsph.errors import InputError
 
             raise InputError(f"{LIMIT_ENV}: expected a number of bytes, got {value!r}") from None
-    meminfo = Path("/proc/meminfo")
-    if meminfo.exists():
-        for line in meminfo.read_text().splitlines():
-            if line.startswith("MemAvailable:"):
-                return int(line.split()[1]) * 1024, "MemAvailable"
-    return None, "unknown"
+    import psutil
+
+    try:
+        return int(psutil.virtual_memory().available), "available memory"
+    except (OSError, RuntimeError):
+        return None, "unknown"
 
 
 def format_bytes(n: float) -> str:

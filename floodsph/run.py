@@ -302,7 +302,8 @@ def _closed_edges(terrain) -> bool | tuple[str, ...]:
 
 
 def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
-    """The ``[[inflows]]`` sections and ``[[sinks]]`` polygons as model boundaries."""
+    """The ``[[inflows]]`` sections and ``[[sinks]]`` polygons (``inputs.sinks``, inline or
+    from vector files) as model boundaries."""
     import numpy as np
 
     from floodsph.boundaries import Inflow, Sink
@@ -316,8 +317,7 @@ def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
         out.append(Inflow(line, hydrograph, numerics.particle_spacing_m, numerics.kappa, terrain,
                           direction=inflow.direction, name=f"{source}: inflows[{i}]"))
     reach = 4.0 * numerics.kappa * numerics.particle_spacing_m
-    for sink in scenario.sinks:
-        polygon = np.column_stack(terrain.to_local(*np.asarray(sink.polygon, dtype=np.float64).T))
+    for polygon in inputs.sinks:
         out.append(Sink(polygon, terrain, reach))
     return out
 

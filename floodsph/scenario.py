@@ -58,7 +58,8 @@ class ScenarioInfo:
 class TerrainConfig:
     """``[terrain]``: the DEM and the bed roughness (a uniform n, an n raster or land cover).
 
-    ``manning`` is None when the roughness comes from ``landcover`` (+ ``manning_table``).
+    ``manning`` is None when the roughness comes from ``landcover`` (+ ``manning_table``: a
+    CSV path, or ``"worldcover"`` for the shipped ESA WorldCover table).
     """
 
     dem: Path
@@ -66,7 +67,7 @@ class TerrainConfig:
     dem_variable: str | None = None
     manning: float | Path | None = N_DEFAULT
     landcover: Path | None = None
-    manning_table: Path | None = None
+    manning_table: Path | str | None = None
     extent: tuple[float, float, float, float] | None = None
     edges: Edges = Edges.OPEN
     closed_sides: tuple[str, ...] = ()
@@ -80,18 +81,32 @@ class TerrainConfig:
 
 @dataclass(frozen=True)
 class InitialWater:
-    """``[[initial_water]]``: a free-surface level inside a polygon, or a depth raster."""
+    """``[[initial_water]]``: a free-surface level inside a polygon, or a depth raster.
+
+    The polygons may come from a vector ``file`` (+ ``layer``, ``crs``) instead of
+    ``polygon`` (``floodsph.io.vector``); ``feature`` names the feature of such a file a
+    body was read from (``floodsph.vector_inputs``).
+    """
 
     level_m: float | None = None
     polygon: tuple[Point, ...] | None = None
     depth: Path | None = None
+    file: Path | None = None
+    layer: str | None = None
+    crs: str | None = None
+    feature: str | None = None
 
 
 @dataclass(frozen=True)
 class Wall:
-    """``[[walls]]``: a polyline water cannot cross (closed: a solid footprint)."""
+    """``[[walls]]``: a polyline water cannot cross (closed: a solid footprint), or the lines
+    and polygon outlines of a vector ``file`` (+ ``layer``, ``crs``; see InitialWater)."""
 
-    polyline: tuple[Point, ...]
+    polyline: tuple[Point, ...] | None = None
+    file: Path | None = None
+    layer: str | None = None
+    crs: str | None = None
+    feature: str | None = None
 
     @property
     def closed(self) -> bool:
@@ -118,17 +133,27 @@ class Inflow:
 
 @dataclass(frozen=True)
 class Sink:
-    """``[[sinks]]``: a polygon where water leaves the model (counted as outflow)."""
+    """``[[sinks]]``: a polygon where water leaves the model (counted as outflow), or the
+    polygons of a vector ``file`` (+ ``layer``, ``crs``; see InitialWater)."""
 
-    polygon: tuple[Point, ...]
+    polygon: tuple[Point, ...] | None = None
+    file: Path | None = None
+    layer: str | None = None
+    crs: str | None = None
+    feature: str | None = None
 
 
 @dataclass(frozen=True)
 class Gauges:
-    """``[gauges]``: a CSV of points (id, x, y) sampled every ``interval_s`` seconds."""
+    """``[gauges]``: a CSV of points (id, x, y), or a vector file of points (+ ``layer``,
+    ``crs``, and ``id_field``, the attribute naming each gauge), sampled every
+    ``interval_s`` seconds."""
 
     file: Path
     interval_s: float = 10.0
+    layer: str | None = None
+    crs: str | None = None
+    id_field: str | None = None
 
 
 @dataclass(frozen=True)
@@ -182,9 +207,11 @@ class Scenario:
     def input_files(self) -> tuple[Path, ...]:
         """The scenario file and every file it reads (a run never writes over them)."""
         t = self.terrain
-        files = [self.path, t.dem, t.landcover, t.manning_table,
+        files = [self.path, t.dem, t.landcover,
+                 t.manning_table if isinstance(t.manning_table, Path) else None,
                  t.manning if isinstance(t.manning, Path) else None,
                  *(w.depth for w in self.initial_water),
+                 *(entry.file for entry in (*self.initial_water, *self.walls, *self.sinks)),
                  *(i.hydrograph for i in self.inflows),
                  None if self.gauges is None else self.gauges.file]
         return tuple(f for f in files if f is not None)
@@ -347,7 +374,7 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         if manning >= N_STRICKLER:
             raise r.fail(join(p, "manning"), strickler_text(manning))
     landcover = r.existing_file(t, p, "landcover", None)
-    manning_table = r.existing_file(t, p, "manning_table", None)
+    manning_table = _manning_table(r, t, p)
     if landcover is not None and "manning" in t:
         raise r.fail(join(p, "landcover"), "give either manning or landcover, not both")
     if manning_table is not None and landcover is None:
@@ -377,6 +404,17 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
     )
 
 
+def _manning_table(r: Reader, t: dict, p: str) -> Path | str | None:
+    """``terrain.manning_table``: a CSV file, or ``"worldcover"`` for the table shipped with
+    floodsph (ESA WorldCover classes, ``floodsph.io.manning``); the name wins over a file
+    of that name."""
+    from floodsph.io.manning import WORLDCOVER
+
+    if t.get("manning_table") == WORLDCOVER:
+        return WORLDCOVER
+    return r.existing_file(t, p, "manning_table", None)
+
+
 SIDES = ("west", "east", "south", "north")
 
 
@@ -396,24 +434,35 @@ def _closed_sides(r: Reader, t: dict, p: str, edges: Edges) -> tuple[str, ...]:
 
 
 def _initial_water(r: Reader, t: dict, p: str) -> InitialWater:
-    r.check_keys(t, p, ("level_m", "polygon", "depth"))
+    r.check_keys(t, p, ("level_m", "polygon", "depth", *VECTOR_KEYS))
     if "depth" in t:
-        if "level_m" in t or "polygon" in t:
+        if "level_m" in t or "polygon" in t or "file" in t:
             raise r.fail(join(p, "depth"), "give either depth or level_m + polygon, not both")
+        r.vector_source(t, p, "depth")
         return InitialWater(depth=r.existing_file(t, p, "depth"))
     if "level_m" not in t:
-        raise r.fail(p, "expected level_m (with polygon) or depth")
-    if "polygon" not in t:
-        raise r.fail(join(p, "polygon"), "required with level_m (the area to fill)")
+        raise r.fail(p, "expected level_m (with polygon or file) or depth")
     level = r.number(t, p, "level_m")
     if abs(level) > ELEVATION_LIMIT_M:
         raise r.fail(join(p, "level_m"), f"{level:g} m is beyond +-{ELEVATION_LIMIT_M:g} m, no "
                                          "water surface on Earth")
+    source = r.vector_source(t, p, "polygon")
+    if source:
+        return InitialWater(level_m=level, **source)
+    if "polygon" not in t:
+        raise r.fail(join(p, "polygon"), "required with level_m (the area to fill), or file")
     return InitialWater(level_m=level, polygon=r.polygon(t, p, "polygon"))
 
 
+VECTOR_KEYS = ("file", "layer", "crs")
+"""Keys of a geometry read from a vector file (``Reader.vector_source``)."""
+
+
 def _wall(r: Reader, t: dict, p: str) -> Wall:
-    r.check_keys(t, p, ("polyline",))
+    r.check_keys(t, p, ("polyline", *VECTOR_KEYS))
+    source = r.vector_source(t, p, "polyline")
+    if source:
+        return Wall(**source)
     return Wall(polyline=r.polyline(t, p, "polyline"))
 
 
@@ -449,17 +498,35 @@ def _breach(r: Reader, value, where: str) -> BreachParams:
 
 
 def _sink(r: Reader, t: dict, p: str) -> Sink:
-    r.check_keys(t, p, ("polygon",))
+    r.check_keys(t, p, ("polygon", *VECTOR_KEYS))
+    source = r.vector_source(t, p, "polygon")
+    if source:
+        return Sink(**source)
     return Sink(polygon=r.polygon(t, p, "polygon"))
 
 
 def _gauges(r: Reader, data: dict) -> Gauges | None:
+    """``[gauges]``: ``file`` is a CSV table, or a vector file (by its extension) with the
+    optional ``layer``, ``crs`` and ``id_field``."""
+    from floodsph.io.vector import is_vector_file
+
     if "gauges" not in data:
         return None
-    t = r.sub_table(data, "", "gauges", ("file", "interval_s"))
+    p = "gauges"
+    t = r.sub_table(data, "", p, ("file", "interval_s", "layer", "crs", "id_field"))
+    file = r.existing_file(t, p, "file")
+    vector = is_vector_file(file)
+    for key in ("layer", "crs", "id_field"):
+        if key in t and not vector:
+            raise r.fail(join(p, key), f"applies only to a vector file of points, but "
+                                       f"gauges.file {file.name} is a CSV table")
+    source = r.vector_source(t, p, None) if vector else {}
     return Gauges(
-        file=r.existing_file(t, "gauges", "file"),
-        interval_s=r.number(t, "gauges", "interval_s", Gauges.interval_s, gt=0.0),
+        file=file,
+        interval_s=r.number(t, p, "interval_s", Gauges.interval_s, gt=0.0),
+        layer=source.get("layer"),
+        crs=source.get("crs"),
+        id_field=r.string(t, p, "id_field", None),
     )
 
 
@@ -516,7 +583,7 @@ def _output(r: Reader, data: dict) -> OutputConfig:
 
 def write_resolved(scenario: Scenario, path: Path) -> None:
     """Write the resolved scenario (absolute paths, defaults filled) as TOML to ``path``."""
-    from floodsph.toml_writer import dumps
+    from tomli_w import dumps
 
     header = (
         f"# Resolved copy of {scenario.path}\n"

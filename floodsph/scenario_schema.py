@@ -210,6 +210,37 @@ class Reader:
             raise self.fail(path, f"not a file: {resolved}")
         return resolved
 
+    def vector_source(self, table: dict, path: str, inline: str | None) -> dict:
+        """``file`` (+ ``layer``, ``crs``): geometry from a vector file, as keyword arguments
+        of the scenario entry (``{}`` without ``file``). ``inline`` names the key it replaces
+        (``polyline``, ``polygon``); both together are refused, as is a file whose extension
+        is not a vector format (:mod:`floodsph.io.vector`) and a ``crs`` pyproj cannot read.
+        """
+        from floodsph.io.vector import VECTOR_SUFFIXES, is_vector_file
+
+        if "file" not in table:
+            for key in ("layer", "crs"):
+                if key in table:
+                    raise self.fail(join(path, key), "applies only with file (a vector file)")
+            return {}
+        if inline is not None and inline in table:
+            raise self.fail(path, f"give either {inline} or file, not both")
+        file = self.existing_file(table, path, "file")
+        if not is_vector_file(file):
+            raise self.fail(join(path, "file"), f"{file.name}: not a vector file; expected "
+                                                f"one of {', '.join(VECTOR_SUFFIXES)}")
+        crs = self.string(table, path, "crs", None)
+        if crs is not None:
+            import pyproj
+
+            try:
+                pyproj.CRS.from_user_input(crs)
+            except pyproj.exceptions.CRSError:
+                raise self.fail(join(path, "crs"), f"{crs!r} is not a coordinate reference "
+                                                   "system pyproj knows") from None
+        out = {"file": file, "layer": self.string(table, path, "layer", None), "crs": crs}
+        return {k: v for k, v in out.items() if v is not None}
+
     # -- geometry -------------------------------------------------------------------------
     def point(self, value: Any, path: str) -> tuple[float, float]:
         """One ``[x, y]`` pair of finite numbers."""

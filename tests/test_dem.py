@@ -239,3 +239,11 @@ def test_utm_zone_choice():
     assert utm_crs_for(6.76, 43.51).to_epsg() == 32632  # Malpasset, France
     assert utm_crs_for(-70.65, -33.45).to_epsg() == 32719  # Santiago de Chile
     assert utm_crs_for(179.99, 10.0).to_epsg() == 32660
+    # Zone borders (multiples of 6 degrees) go to the eastern zone; the edges of the map and
+    # the poles stay in zones 1..60.
+    assert utm_crs_for(0.0, 10.0).to_epsg() == 32631
+    assert utm_crs_for(-180.0, -10.0).to_epsg() == 32701
+    assert utm_crs_for(180.0, 10.0).to_epsg() == 32660
+    assert utm_crs_for(20.0, 89.0).to_epsg() == 32634
+    # Bergen lies in the regular zone 31 (the military grid's zone 32V is not an EPSG area).
+    assert utm_crs_for(5.32, 60.39).to_epsg() == 32631

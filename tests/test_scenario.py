@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-import tomllib
+import json
+from pathlib import Path
 
 import pytest
 from conftest import BASE_SCENARIO, X0, Y0
@@ -15,7 +16,6 @@ from floodsph.scenario import (
     load_scenario,
     write_resolved,
 )
-from floodsph.toml_writer import dumps
 
 MINIMAL = """\
 [scenario]
@@ -57,10 +57,17 @@ def test_resolved_copy_reloads_to_the_same_scenario(scenario_file, tmp_path):
     assert again.initial_water[0].polygon[1] == (X0 + 400.0, Y0)
 
 
-def test_toml_writer_escapes_strings():
-    data = {"a": {"s": 'quote " back \\ tab \t é', "n": [1, 2.5], "b": True},
-            "t": [{"x": 1}, {"x": 2, "sub": {"k": "v"}}]}
-    assert tomllib.loads(dumps(data)) == data
+def test_resolved_copy_keeps_awkward_strings(write_scenario, tmp_path):
+    # Quotes, backslashes, a tab and non-ASCII letters in a string survive the resolved copy.
+    description = 'quote " back \\ tab \t é'
+    text = BASE_SCENARIO.replace('name = "valley"',
+                                 f'name = "valley"\ndescription = {json.dumps(description)}')
+    assert text != BASE_SCENARIO
+    sc = load_scenario(write_scenario(text))
+    write_resolved(sc, tmp_path / "resolved.toml")
+    again = load_scenario(tmp_path / "resolved.toml")
+    assert again.scenario.description == description
+    assert again.to_dict() == sc.to_dict()
 
 
 def error_of(write_scenario, text) -> str:
@@ -117,7 +124,8 @@ POLY = "[[0, 0], [10, 0], [10, 10]]"
          "bogus: unknown key; allowed keys: gauges, inflows, initial_water, numerics, output, "
          "scenario, sinks, terrain, walls"),
         (("level_m = 100.0", "level_m = 100.0\ncolour = 1"),
-         "initial_water[0].colour: unknown key; allowed keys: depth, level_m, polygon"),
+         "initial_water[0].colour: unknown key; allowed keys: crs, depth, file, layer, level_m, "
+         "polygon"),
     ],
 )
 def test_bad_values_name_the_key(write_scenario, change, message):
@@ -235,3 +243,30 @@ def test_closed_sides_are_walls_and_the_other_sides_open(write_scenario):
     west = model.seg[(model.seg[:, 0] == 0.0) & (model.seg[:, 2] == 0.0)]
     assert west.shape[0] == 1
     assert abs(west[0, 3] - west[0, 1]) >= model.terrain.height  # the whole side, and beyond
+
+
+def test_worldcover_manning_table_from_toml(write_scenario, tmp_path):
+    # Land cover on the DEM grid: the western half tree cover (ESA WorldCover class 10), the
+    # eastern half cropland (40); the shipped table documents n for each class by name.
+    import csv
+
+    import numpy as np
+    from conftest import NX, NY, write_geotiff
+
+    from floodsph.inputs import prepare_inputs
+
+    classes = np.where(np.arange(NX)[None, :] < NX // 2, 10, 40) * np.ones((NY, 1))
+    write_geotiff(tmp_path / "landcover.tif", classes, nodata=0)
+    text = BASE_SCENARIO.replace(
+        "manning = 0.03", 'landcover = "landcover.tif"\nmanning_table = "worldcover"')
+    sc = load_scenario(write_scenario(text))
+    assert sc.terrain.manning_table == "worldcover" and sc.terrain.manning is None
+    table_file = Path(__file__).parents[1] / "floodsph" / "data" / "worldcover_manning.csv"
+    with open(table_file, encoding="utf-8") as f:
+        documented = {row["name"]: float(row["manning_n"]) for row in csv.DictReader(f)}
+    n = prepare_inputs(sc).terrain.manning
+    assert np.all(n[:, : NX // 2] == documented["Tree cover"])
+    assert np.all(n[:, NX // 2:] == documented["Cropland"])
+    resolved = tmp_path / "resolved.toml"
+    write_resolved(sc, resolved)
+    assert load_scenario(resolved).terrain.manning_table == "worldcover"

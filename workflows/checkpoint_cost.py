@@ -26,9 +26,10 @@ DOC = setup.REPO / "docs" / "checkpoint-cost.md"
 
 def measure(folder: Path, out: Path, end_time: float, interval: float) -> dict:
     """Run Malpasset with checkpoints every ``interval`` s; the cost figures of its run.json."""
+    from tomli_w import dumps
+
     from floodsph.run import run_scenario
     from floodsph.scenario import load_scenario
-    from floodsph.toml_writer import dumps
 
     path = setup.write_scenario(folder, out, "particles", end_time, 20.0)
     data = tomllib.loads(path.read_text(encoding="utf-8"))

@@ -12,7 +12,7 @@ Variants of the base (default ``data_samples/valley/scenario.toml``):
   the formation time, each times each ``--breach-factors`` (default 0.5 and 1.5), starting
   from the values the base implies (given, or Froehlich 2008 from ``floodsph.breach``).
 
-Each variant is written as a scenario TOML (``floodsph.toml_writer``, from the base's resolved
+Each variant is written as a scenario TOML (``tomli_w``, from the base's resolved
 copy: absolute paths, every default filled) into ``<out>/scenarios/``, run with
 ``floodsph.run.run_scenario`` into ``<out>/runs/<variant>/``, and compared with the base by
 ``floodsph.compare.compare`` (model = variant, reference = base; wet = depth > ``--threshold``,
@@ -155,7 +155,7 @@ def make_variants(base: dict, folder: Path, manning_factors=(0.8, 1.2),
 
 def write_variant(v: Variant, scenarios: Path, runs: Path, base_name: str) -> Path:
     """``scenarios/<name>.toml`` with its run folder ``runs/<name>``; returns the TOML path."""
-    from floodsph.toml_writer import dumps
+    from tomli_w import dumps
 
     data = copy.deepcopy(v.data)
     data["scenario"]["name"] = f"{base_name}-{v.name}"

@@ -191,7 +191,7 @@ def keyhole(outer: list, hole: list) -> list:
 def scenario_text(name: str, end_time: float, dem: str, manning: float, water: list,
                   walls: list, spacing: float) -> str:
     """A scenario TOML (scenario-format.md): closed edges, default numerics, GeoTIFF maps."""
-    from floodsph.toml_writer import dumps
+    from tomli_w import dumps
 
     data = {
         "scenario": {"name": name, "end_time_s": float(end_time),
@@ -320,7 +320,7 @@ def dam_wall(overhang: float = DAM_WALL_OVERHANG_M) -> list:
 
 def malpasset(folder: Path, end_time: float, data: Path) -> Case:
     """The Malpasset reservoir at rest behind a wall along the dam line."""
-    from floodsph.toml_writer import dumps
+    from tomli_w import dumps
 
     folder.mkdir(parents=True, exist_ok=True)
     bounds = mp_setup.dem_bounds(data)

@@ -75,12 +75,14 @@ def check_geometry_on_dem(scenario, terrain, spacing_m: float, source: str) -> N
     """Refuse polygons and walls wholly off the DEM, and inflow lines off it or too short.
 
     A polygon must share a non-zero area with the DEM rectangle and a wall a non-zero length;
-    a part outside is allowed (a reservoir outline drawn beyond a cropped DEM).
+    a part outside is allowed (a reservoir outline drawn beyond a cropped DEM). Geometry read
+    from a vector file is named by its file and feature (``feature`` of the entry).
     """
     box = dem_box(terrain)
-    polygons = [(f"initial_water[{i}].polygon", body.polygon)
+    polygons = [(body.feature or f"initial_water[{i}].polygon", body.polygon)
                 for i, body in enumerate(scenario.initial_water) if body.polygon is not None]
-    polygons += [(f"sinks[{i}].polygon", sink.polygon) for i, sink in enumerate(scenario.sinks)]
+    polygons += [(sink.feature or f"sinks[{i}].polygon", sink.polygon)
+                 for i, sink in enumerate(scenario.sinks)]
     for key, points in polygons:
         # make_valid: a keyhole ring (allowed, floodsph.checks.shapes) is not valid for GEOS.
         area = shapely.make_valid(shapely.Polygon(points))
@@ -89,7 +91,8 @@ def check_geometry_on_dem(scenario, terrain, spacing_m: float, source: str) -> N
     for i, wall in enumerate(scenario.walls):
         line = shapely.LineString(wall.polyline)
         if shapely.intersection(line, box).length <= 0.0:
-            raise off_dem_error(f"{source}: walls[{i}].polyline", "the wall lies wholly",
+            raise off_dem_error(f"{source}: {wall.feature or f'walls[{i}].polyline'}",
+                                "the wall lies wholly",
                                 wall.polyline, terrain)
     for i, inflow in enumerate(scenario.inflows):
         where = f"{source}: inflows[{i}].line"

@@ -220,7 +220,7 @@ def _validate(spec: EnsembleSpec, base: Scenario, data: dict) -> Scenario:
 
 
 def _toml(spec: EnsembleSpec, mid: str, bindings, drawn, resolved: dict) -> str:
-    from floodsph.toml_writer import dumps
+    from tomli_w import dumps
 
     lines = [f"# Member {mid} of the ensemble {spec.name!r} ({spec.path}); sampled values:"]
     lines += [f"#   {b.describe(v)}" for b, v in zip(bindings, drawn, strict=True)]

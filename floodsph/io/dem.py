@@ -178,12 +178,27 @@ def _ensure_projected_metres(grid: Grid, path: Path, warnings=None) -> Grid:
 
 
 def utm_crs_for(lon: float, lat: float) -> CRS:
-    """WGS 84 / UTM zone of a point: EPSG 326zz (north) or 327zz (south), zz = 1..60.
+    """The WGS 84 / UTM zone of a point (EPSG 326zz north of the equator, 327zz south), picked
+    by pyproj (``pyproj.database.query_utm_crs_info``) from the EPSG areas of use.
 
-    zone = floor((lon + 180) / 6) + 1 (the Norway/Svalbard exceptions are not applied).
+    Those areas are the regular 6-degree zones; the Norway (32V) and Svalbard (31X-37X)
+    exceptions of the military grid are not among them, so a DEM there gets its regular zone,
+    whose scale error stays below 0.1 % within the zone. On a zone border (a longitude that
+    is a multiple of 6 degrees) the eastern zone is taken.
     """
-    zone = min(max(int(math.floor((lon + 180.0) / 6.0)) + 1, 1), 60)
-    return CRS.from_epsg((32600 if lat >= 0.0 else 32700) + zone)
+    from pyproj.aoi import AreaOfInterest
+    from pyproj.database import query_utm_crs_info
+
+    lon = min(max(float(lon), -180.0), 180.0)
+    lat = min(max(float(lat), -80.0), 84.0)
+    hemisphere = "N" if lat >= 0.0 else "S"
+    found = [info for info in query_utm_crs_info(
+                 datum_name="WGS 84", area_of_interest=AreaOfInterest(lon, lat, lon, lat))
+             if info.name.endswith(hemisphere)]
+    if not found:
+        raise InputError(f"no UTM zone covers longitude {lon:g}, latitude {lat:g}")
+    eastern = max(found, key=lambda info: info.area_of_use.west)
+    return CRS.from_epsg(int(eastern.code))
 
 
 def metric_cell_size(t: Affine, shape: tuple[int, int]) -> float:

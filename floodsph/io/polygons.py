@@ -1,4 +1,4 @@
-"""Polygon checks and point-in-polygon tests for scenario polygons (no shapely).
+"""Polygon checks and inside tests for scenario polygons, through shapely.
 
 A polygon is a ``(k, 2)`` array of vertices; it may be given closed (first == last) or
 open. :func:`check_polygon` refuses degenerate ones with a message naming the key path.
@@ -7,6 +7,7 @@ open. :func:`check_polygon` refuses degenerate ones with a message naming the ke
 from __future__ import annotations
 
 import numpy as np
+import shapely
 
 from floodsph.errors import InputError
 
@@ -16,7 +17,7 @@ def check_polygon(points, name: str) -> np.ndarray:
 
     Refused (InputError naming ``name``, e.g. ``initial_water[0].polygon``): not a list of
     [x, y] pairs, non-finite coordinates, fewer than 3 distinct vertices, or zero area
-    (shoelace formula A = 1/2 |sum(x_i y_{i+1} - x_{i+1} y_i)|).
+    (:func:`polygon_area`).
     """
     try:
         p = np.asarray(points, dtype=np.float64)
@@ -36,27 +37,19 @@ def check_polygon(points, name: str) -> np.ndarray:
 
 
 def polygon_area(p: np.ndarray) -> float:
-    """Unsigned area of a simple polygon by the shoelace formula [m2]."""
-    x, y = p[:, 0], p[:, 1]
-    return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y)))
+    """Area [m2] enclosed by the ring ``p`` (k, 2): the absolute shoelace sum
+    A = 1/2 |sum(x_i y_(i+1) - x_(i+1) y_i)| that shapely computes for a polygon."""
+    return float(shapely.area(shapely.polygons(np.asarray(p, dtype=np.float64))))
 
 
 def points_in_polygon(x: np.ndarray, y: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """Even-odd rule: True where the point (x, y) is inside the polygon ``poly`` (k, 2).
+    """True where the point (x, y) lies inside the ring ``poly`` (k, 2) or on its outline.
 
-    A horizontal ray from each point crosses edge (a, b) when the edge straddles the
-    point's y (half-open test ``(ya > y) != (yb > y)``) and the crossing abscissa
-    ``xa + (y - ya)(xb - xa)/(yb - ya)`` lies right of the point; inside = odd crossings.
+    shapely's point locator counts the crossings of a ray from the point with the ring's
+    edges, so a ring that describes a hole through a zero-width slit (a keyhole ring, out
+    along the slit, round the hole, back) leaves the hole outside: the even-odd rule.
     """
-    x = np.asarray(x, dtype=np.float64)
-    y = np.asarray(y, dtype=np.float64)
-    inside = np.zeros(np.broadcast(x, y).shape, dtype=bool)
-    xa, ya = poly[:, 0], poly[:, 1]
-    xb, yb = np.roll(xa, -1), np.roll(ya, -1)
-    for k in range(len(poly)):
-        if ya[k] == yb[k]:
-            continue
-        straddles = (ya[k] > y) != (yb[k] > y)
-        x_cross = xa[k] + (y - ya[k]) * (xb[k] - xa[k]) / (yb[k] - ya[k])
-        inside ^= straddles & (x < x_cross)
-    return inside
+    ring = shapely.polygons(np.asarray(poly, dtype=np.float64))
+    shapely.prepare(ring)
+    return shapely.intersects_xy(ring, np.asarray(x, dtype=np.float64),
+                                 np.asarray(y, dtype=np.float64))

@@ -84,8 +84,9 @@ def write_inputs(folder: Path, out: Path, end_time: float, dem_cell: int,
 
     ``time_stepping`` is ``numerics.time_stepping`` ("global" or "local"), ``refinement``
     ``numerics.refinement`` (None: floodsph's default)."""
+    from tomli_w import dumps
+
     from floodsph.hydrograph import read_hydrograph, write_hydrograph_csv
-    from floodsph.toml_writer import dumps
 
     hydrograph = read_hydrograph(folder / HYDROGRAPH_NAME, "EA test 4 hydrograph")
     write_hydrograph_csv(out / "ea4_hydrograph.csv", hydrograph.t, hydrograph.Q)

@@ -169,7 +169,7 @@ def scenario_dict(dem: str, bounds, sea: str, end_time: float, spacing: float,
                   gauges: str | None = None, gauge_interval: float = 5.0,
                   sea_outline_ring: list | None = None, refinement: str | None = None,
                   time_stepping: str | None = None) -> dict:
-    """The Malpasset scenario (scenario-format.md) as plain data for ``toml_writer.dumps``.
+    """The Malpasset scenario (scenario-format.md) as plain data for ``tomli_w.dumps``.
 
     ``sea`` is one of SEA_MODES; ``"sink"`` needs ``sea_outline_ring`` (:func:`sea_outline`).
     ``refinement`` and ``time_stepping`` set those ``numerics`` keys (default: floodsph's).
@@ -207,7 +207,7 @@ def write_scenario(folder: Path, out: Path, sea: str, end_time: float, spacing: 
                    gauge_interval: float = 5.0, refinement: str | None = None,
                    time_stepping: str | None = None) -> Path:
     """``out/malpasset.toml`` (absolute paths to the data) and ``out/gauges_epsg27572.csv``."""
-    from floodsph.toml_writer import dumps
+    from tomli_w import dumps
 
     out.mkdir(parents=True, exist_ok=True)
     gauges = write_gauges(read_points(folder), out / "gauges_epsg27572.csv")
@@ -233,7 +233,7 @@ STATIC_HEADER = """\
 
 def write_static_scenario(folder: Path, path: Path) -> Path:
     """The repository's ``scenario.toml``: no gauges, DEM path relative to ``path``."""
-    from floodsph.toml_writer import dumps
+    from tomli_w import dumps
 
     dem = os.path.relpath(folder / DEM_NAME, path.parent)
     data = scenario_dict(dem, dem_bounds(folder), "particles", END_TIME_S, 20.0)

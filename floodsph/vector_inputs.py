@@ -1,0 +1,137 @@
+"""Scenario geometry from vector files, placed on the DEM (``floodsph.inputs``).
+
+An entry with ``file`` (``[[walls]]``, ``[[initial_water]]``, ``[[sinks]]``) becomes one entry
+per part of each feature, with its coordinates in the DEM's CRS, checked as inline ones
+(:mod:`floodsph.checks.shapes`) and labelled ``walls[0].file walls.gpkg, feature 3`` for
+messages:
+
+* walls: each line (LineString, and each part of a MultiLineString) is a wall, each polygon's
+  outline a closed wall (a solid footprint);
+* initial water and sinks: each polygon (and each part of a MultiPolygon) is one area; a
+  polygon with holes is refused (draw the island as its own body, or leave it: ground above
+  the level stays dry anyway).
+
+A feature of another geometry type, or a file without features, is refused naming the file.
+``[gauges]`` points come from :func:`vector_gauges`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from floodsph.checks.shapes import polygon_problem, polyline_problem
+from floodsph.errors import InputError
+from floodsph.io.vector import read_vector
+
+POLYGONS = ("Polygon", "MultiPolygon")
+LINES = ("LineString", "MultiLineString")
+
+
+def with_vector_geometry(scenario, terrain):
+    """``scenario`` with every vector-file entry replaced by inline entries in the DEM's CRS
+    (the same scenario when it has none)."""
+    if not any(e.file is not None for e in (*scenario.walls, *scenario.initial_water,
+                                            *scenario.sinks)):
+        return scenario
+    source = scenario.path.name
+
+    def expand(entries, kind: str, field: str, types: tuple[str, ...]):
+        out = []
+        for i, entry in enumerate(entries):
+            if entry.file is None:
+                out.append(entry)
+                continue
+            where = f"{source}: {kind}[{i}].file {entry.file.name}"
+            for label, points in _parts(entry, where, terrain, types):
+                out.append(replace(entry, file=None, layer=None, crs=None, feature=label,
+                                   **{field: points}))
+        return tuple(out)
+
+    return replace(
+        scenario,
+        walls=expand(scenario.walls, "walls", "polyline", LINES + POLYGONS),
+        initial_water=expand(scenario.initial_water, "initial_water", "polygon", POLYGONS),
+        sinks=expand(scenario.sinks, "sinks", "polygon", POLYGONS),
+    )
+
+
+def _parts(entry, where: str, terrain, types: tuple[str, ...]):
+    """``(label, points)`` of each part of each feature of ``entry.file``."""
+    import shapely
+
+    features = read_vector(entry.file, where, terrain.crs_wkt, layer=entry.layer,
+                           crs=entry.crs)
+    out = []
+    for k, geometry in enumerate(features.geometries, start=1):
+        label = f"{where.split(': ', 1)[1]}, feature {k}"
+        kind = None if geometry is None else geometry.geom_type
+        if kind not in types:
+            raise InputError(f"{where}: feature {k} is {kind or 'empty'}; expected "
+                             f"{' or '.join(types)} here")
+        for part in shapely.get_parts(geometry):
+            if part.geom_type == "Polygon":
+                if len(part.interiors):
+                    raise InputError(f"{where}: feature {k} is a polygon with "
+                                     f"{len(part.interiors)} hole(s); give its outline only "
+                                     "(ground above the level stays dry anyway)")
+                points = _points(part.exterior.coords)
+                problem = (polyline_problem(points) if "LineString" in types
+                           else polygon_problem(points))
+            else:
+                points = _points(part.coords)
+                problem = polyline_problem(points)
+            if problem is not None:
+                raise InputError(f"{where}: feature {k}: {problem}")
+            out.append((label, points))
+    if not out:
+        raise InputError(f"{where}: holds no features")
+    return out
+
+
+def _points(coords) -> tuple[tuple[float, float], ...]:
+    return tuple((float(x), float(y)) for x, y in np.asarray(coords, dtype=np.float64)[:, :2])
+
+
+def vector_gauges(gauges, terrain, source: str):
+    """The gauge points of a vector ``[gauges] file`` (Point or MultiPoint features) in LOCAL
+    coordinates, named by the ``id_field`` attribute (default ``id`` when the layer has it,
+    else the feature number from 1)."""
+    from floodsph.checks.placement import extent_text, lonlat_hint
+    from floodsph.output.gauges import GaugePoints
+    from floodsph.output.grid import bilinear
+
+    where = f"{source}: gauges.file {gauges.file.name}"
+    features = read_vector(gauges.file, where, terrain.crs_wkt, layer=gauges.layer,
+                           crs=gauges.crs)
+    field = gauges.id_field
+    if field is None and features.properties and "id" in features.properties[0]:
+        field = "id"
+    ids, xs, ys = [], [], []
+    for k, (geometry, props) in enumerate(zip(features.geometries, features.properties,
+                                              strict=True), start=1):
+        if geometry is None or geometry.geom_type not in ("Point", "MultiPoint"):
+            kind = "empty" if geometry is None else geometry.geom_type
+            raise InputError(f"{where}: feature {k} is {kind}; gauges are Point features")
+        if field is not None and field not in props:
+            raise InputError(f"{where}: gauges.id_field: the features have no attribute "
+                             f"{field!r}; they have {sorted(props)}")
+        for x, y in np.asarray(geometry.__geo_interface__["coordinates"],
+                               dtype=np.float64).reshape(-1, 2):
+            gid = str(props[field]) if field is not None else str(k)
+            lx, ly = x - terrain.x0, y - terrain.y0
+            if not (0.0 <= lx <= terrain.width and 0.0 <= ly <= terrain.height):
+                raise InputError(f"{where}: feature {k}: gauge {gid!r} at ({x:.10g}, "
+                                 f"{y:.10g}) is outside the DEM extent {extent_text(terrain)}"
+                                 f"{lonlat_hint([(x, y)], terrain)}")
+            if gid in ids:
+                raise InputError(f"{where}: feature {k}: duplicate gauge id {gid!r}")
+            ids.append(gid)
+            xs.append(lx)
+            ys.append(ly)
+    if not ids:
+        raise InputError(f"{where}: holds no gauge points")
+    x, y = np.array(xs), np.array(ys)
+    return GaugePoints(tuple(ids), x, y, bilinear(terrain.elevation, terrain.dx, terrain.dy,
+                                                  x, y))
