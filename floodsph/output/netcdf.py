@@ -68,11 +68,12 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
     crs = grid_mapping_attrs(grid)
     coords = grid_coords(grid)
     coords[THRESHOLD] = xr.Variable((), np.float64(wet_threshold), THRESHOLD_ATTRS)
-    data_vars, encoding = {}, no_fill(("x", "y", THRESHOLD, "time", "time_bounds"))
+    data_vars = {}
     if period_s is not None:
         coords["time"] = xr.Variable((), np.float64(period_s),
                                      dict(TIME_ATTRS, bounds="time_bounds"))
         data_vars["time_bounds"] = xr.Variable("nv", np.array([0.0, period_s]))
+    encoding = no_fill([*coords, *data_vars])
     if crs is not None:
         data_vars["crs"] = xr.Variable((), np.int32(0), crs)
         encoding["crs"] = {"dtype": "int32"}
