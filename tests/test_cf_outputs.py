@@ -1,7 +1,8 @@
 """A small run's flood_maps.nc and snapshots.nc against the CF-1.8 conventions.
 
-The run: the conftest valley with 3 m of water held in its western 100 m, released at t = 0
-(a dam break onto the 100 m floor), 6 s, snapshots every 2 s. The attributes are checked
+The run: the conftest valley with water at level 101 m held in its western 200 m (3 m deep
+in the basin, 1 m on the floor), released at t = 0 onto the dry eastern floor (a dam break),
+6 s, snapshots every 2 s. The attributes are checked
 against the CF rules themselves (coordinate variables without _FillValue, flag values that
 are the class values, time units that a CF time library decodes, standard names of the CF
 table), then, where installed (``pip install floodsph[cf]``), by the CF checker (cfchecks:
@@ -24,7 +25,7 @@ from floodsph.output.envelopes import MAPS
 from floodsph.run import run_scenario
 from floodsph.scenario import load_scenario
 
-END_S, SNAPSHOT_S, WET_M = 6.0, 2.0, 0.02
+END_S, SNAPSHOT_S, WET_M, DAM_M = 6.0, 2.0, 0.02, 200.0
 DAM_BREAK = f"""
 [scenario]
 name = "cf"
@@ -37,7 +38,7 @@ edges = "closed"
 
 [[initial_water]]
 level_m = 101.0
-polygon = [[{X0}, {Y0}], [{X0 + 100}, {Y0}], [{X0 + 100}, {Y0 + NY * CELL}],
+polygon = [[{X0}, {Y0}], [{X0 + DAM_M}, {Y0}], [{X0 + DAM_M}, {Y0 + NY * CELL}],
            [{X0}, {Y0 + NY * CELL}]]
 
 [numerics]
@@ -80,7 +81,7 @@ def test_the_dam_break_reached_the_floor(run_dir):
     with netCDF4.Dataset(run_dir / "flood_maps.nc") as ds:
         depth = ds["max_depth"][:].filled(np.nan)
         x = ds["x"][:]
-    assert np.nanmax(depth[:, x > X0 + 110.0]) > 0.1
+    assert np.nanmax(depth[:, x > X0 + DAM_M]) > 0.1
     with netCDF4.Dataset(run_dir / "snapshots.nc") as ds:
         assert ds["depth"].shape[0] == len(np.arange(0.0, END_S + 1e-9, SNAPSHOT_S))
 
