@@ -63,7 +63,7 @@ def test_geotiffs_read_back_north_up_with_crs_and_transform(envelopes, run_dir):
             assert src.crs == CRS_UTM
             assert src.transform == from_origin(X0, Y0 + 200.0, CELL, CELL)
             assert src.descriptions == (name,) and src.tags(1)["units"] == units
-            assert src.units == (units,)            # GDAL's band unit type, as QGIS reads it
+            assert src.units == (units,)            # GDAL's band unit type
             assert src.tags()["wet_threshold_m"] == "0.05"
             assert src.profile["tiled"] and src.profile["compress"] == "deflate"
             data = src.read(1)
