@@ -1,11 +1,12 @@
 """Compare two flood maps: binary wet/dry skill scores, depth errors, arrival-time errors.
 
-``compare(model, reference)`` reprojects the REFERENCE raster onto the MODEL raster's grid
-(``rasterio.warp.reproject``: bilinear for depth and arrival time, nearest for class maps)
-and evaluates only the cells the reference raster covers. A cell is wet when its depth is
-above the threshold (class maps: class > 0); NaN/nodata counts as dry. With hits = wet in
-both, false alarms = wet in the model only, misses = wet in the reference only
-(flood-practice.md section 1.6; seamlesswave.com/metrics; Wing et al. 2017 use 0.10 m):
+``compare(model, reference)`` reads each map as one band (a raster file, or a NetCDF variable
+``flood_maps.nc:max_depth``: :mod:`floodsph.map_source`), reprojects the REFERENCE map onto
+the MODEL map's grid (``rasterio.warp.reproject``: bilinear for depth and arrival time,
+nearest for class maps) and evaluates only the cells the reference map covers. A cell is wet
+when its depth is above the threshold (class maps: class > 0); NaN/nodata counts as dry.
+With hits = wet in both, false alarms = wet in the model only, misses = wet in the reference
+only (flood-practice.md section 1.6; seamlesswave.com/metrics; Wing et al. 2017 use 0.10 m):
 
     H   = hits / (hits + misses)                               hit rate
     FAR = false alarms / (hits + false alarms)                 false alarm ratio
@@ -15,10 +16,11 @@ both, false alarms = wet in the model only, misses = wet in the reference only
 
 An undefined ratio (0 / 0) is NaN. Depth errors over cells wet in both, e = model - ref:
 RMSE = sqrt(mean e^2), bias = mean e, MAE = mean |e|. CSI favours over-prediction (Stephens
-et al. 2014): read it with the depth errors. Arrival-time maps (band description containing
-"arrival", or ``arrival=True``) give the mean and RMSE of the arrival difference over cells
-wet in both. Optional observation points (CSV ``id, x, y, observed``) give the same depth
-error statistics at the points (a dry model cell counts as depth 0).
+et al. 2014): read it with the depth errors. Arrival-time maps (``arrival=True``, or a band
+description, NetCDF variable or standard name that says arrival) give the mean and RMSE of
+the arrival difference over cells wet in both. Optional observation points (CSV ``id, x, y,
+observed``) give the same depth error statistics at the points (a dry model cell counts as
+depth 0).
 """
 
 from __future__ import annotations
@@ -32,41 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from floodsph.errors import InputError
-
-
-@dataclass
-class Raster:
-    """One band of a map file: data as float64 (NaN = nodata), georeference and kind."""
-
-    path: Path
-    data: np.ndarray
-    transform: object
-    crs: object
-    kind: str  # "depth", "arrival" or "class"
-
-
-def read_raster(path, arrival: bool = False) -> Raster:
-    """Read band 1 of a raster; InputError if it cannot be read or has no CRS."""
-    import rasterio
-
-    path = Path(path)
-    try:
-        with rasterio.open(path) as src:
-            data = src.read(1).astype(np.float64)
-            nodata, dtype = src.nodata, src.dtypes[0]
-            transform, crs, desc = src.transform, src.crs, (src.descriptions[0] or "")
-    except rasterio.errors.RasterioIOError as e:
-        raise InputError(f"{path}: cannot read raster ({e})") from None
-    if crs is None:
-        raise InputError(f"{path}: the raster has no CRS; cannot align it with the other map")
-    if np.issubdtype(np.dtype(dtype), np.integer):
-        kind = "class"
-        data[data == (nodata if nodata is not None else 0)] = 0.0
-    else:
-        kind = "arrival" if arrival or "arrival" in desc.lower() else "depth"
-        if nodata is not None and not math.isnan(nodata):
-            data[data == nodata] = np.nan
-    return Raster(path, data, transform, crs, kind)
+from floodsph.map_source import Raster, read_raster
 
 
 def align(model: Raster, ref: Raster) -> tuple[np.ndarray, np.ndarray]:
@@ -254,7 +222,9 @@ def write_outputs(result: Comparison, out_dir) -> list:
     with rasterio.open(diff_path, "w", **profile) as dst:
         dst.write(result.difference.astype(np.float32), 1)
         dst.set_band_description(1, f"{result.summary['kind']} difference (model - reference)")
-        dst.update_tags(1, units="s" if result.summary["kind"] == "arrival" else "m")
+        units = "s" if result.summary["kind"] == "arrival" else "m"
+        dst.set_band_unit(1, units)
+        dst.update_tags(1, units=units)
     json_path = out_dir / "comparison.json"
     json_path.write_text(json.dumps(_finite(result.summary), indent=2) + "\n")
     from floodsph.output.pictures import plot_comparison

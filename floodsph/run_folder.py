@@ -51,7 +51,8 @@ MAP_NAMES = (
     "flood_maps.nc",
 )
 #: Quick-look PNGs written by ``floodsph.output.write_pictures`` when matplotlib is installed.
-PICTURE_NAMES = ("max_depth.png", "hazard_uk.png", "hazard_arr.png", "arrival_time.png")
+PICTURE_NAMES = ("max_depth.png", "max_speed.png", "max_unit_discharge.png", "duration.png",
+                 "hazard_uk.png", "hazard_arr.png", "arrival_time.png")
 #: Every file name a run writes (scenario-format.md, "Run folder"); a run's files in progress
 #: carry one of these names with a suffix (``snapshots.nc.part``, ``max_depth.tif.part``).
 RUN_FILES = (*MAP_NAMES, SNAPSHOTS_NAME, GAUGES_NAME, MASS_BALANCE_NAME, MANIFEST_NAME,

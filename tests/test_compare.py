@@ -120,3 +120,86 @@ def test_cli_prints_table_and_writes_outputs(tmp_path):
         assert src.crs == CRS.from_epsg(32633)
         assert src.read(1)[5, 5] == pytest.approx(0.8)
     assert (out / "comparison.png").stat().st_size > 0
+
+
+def netcdf_and_geotiffs(folder, maps):
+    """``maps`` (north-up, name -> array) written by the run's writers as ``<name>.tif`` and
+    as variables of ``flood_maps.nc`` on the grid of :func:`write` (EPSG:32633)."""
+    from floodsph.output.envelopes import MAPS
+    from floodsph.output.geotiff import write_geotiff
+    from floodsph.output.grid import OutputGrid
+    from floodsph.output.netcdf import write_flood_maps
+
+    ny, nx = next(iter(maps.values())).shape
+    grid = OutputGrid(nx, ny, CELL, CELL, WEST, NORTH - ny * CELL,
+                      CRS.from_epsg(32633).to_wkt(), np.zeros((ny, nx)))
+    south_up = {name: a[::-1] for name, a in maps.items()}
+    for name, a in south_up.items():
+        write_geotiff(folder / f"{name}.tif", a, grid, name, MAPS[name][1])
+    names = {"hazard_uk": ("Dry", "Low", "Some", "Most", "All")}
+    return write_flood_maps(folder / "flood_maps.nc", south_up, MAPS, grid, class_names=names)
+
+
+def shifted_maps():
+    """A depth block with arrival times and UK classes, and the same block 2 cells east."""
+    depth = np.full((20, 30), np.nan, dtype=np.float32)
+    depth[4:12, 5:15] = np.linspace(0.05, 1.5, 80, dtype=np.float32).reshape(8, 10)
+    arrival = np.where(np.isfinite(depth), 30.0 + np.arange(30, dtype=np.float32), np.nan)
+    hazard = np.where(np.nan_to_num(depth) > 0.1, 1 + (np.nan_to_num(depth) > 0.8), 0)
+    model = {"max_depth": depth, "arrival_time": arrival.astype(np.float32),
+             "hazard_uk": hazard.astype(np.uint8)}
+    return model, {name: np.roll(a, 2, axis=1) for name, a in model.items()}
+
+
+@pytest.mark.parametrize("name", ["max_depth", "arrival_time", "hazard_uk"])
+def test_a_netcdf_variable_gives_the_numbers_of_its_geotiff(tmp_path, name):
+    model, ref = shifted_maps()
+    nc = netcdf_and_geotiffs(tmp_path, model)
+    (tmp_path / "ref").mkdir()
+    netcdf_and_geotiffs(tmp_path / "ref", ref)
+    reference = tmp_path / "ref" / f"{name}.tif"
+    from_tif = compare(tmp_path / f"{name}.tif", reference)
+    from_nc = compare(f"{nc}:{name}", reference)
+    from_both = compare(f"{nc}:{name}", f"{tmp_path / 'ref' / 'flood_maps.nc'}:{name}")
+    expected_kind = {"max_depth": "depth", "arrival_time": "arrival", "hazard_uk": "class"}
+    assert from_tif.summary["kind"] == expected_kind[name]
+    assert from_tif.summary["hits"] > 0 and from_tif.summary["misses"] > 0
+    for other in (from_nc, from_both):
+        assert {k: v for k, v in other.summary.items() if k not in ("model", "reference")} == \
+            {k: v for k, v in from_tif.summary.items() if k not in ("model", "reference")}
+        np.testing.assert_array_equal(other.difference, from_tif.difference)
+    assert from_nc.summary["model"] == f"{nc}:{name}"
+
+
+def compare_cli(*args):
+    from floodsph.cli.main import cli
+
+    return CliRunner().invoke(cli, ["compare", *[str(a) for a in args]])
+
+
+def assert_one_message(result, *parts):
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output and result.output.count("Error:") == 1
+    for part in parts:
+        assert part in result.output, result.output
+
+
+def test_compare_errors_name_the_map_at_fault(tmp_path):
+    model, _ = shifted_maps()
+    nc = netcdf_and_geotiffs(tmp_path, model)
+    tif = tmp_path / "max_depth.tif"
+    assert_one_message(compare_cli(tif, nc), f"{nc} holds several maps (max_depth, ",
+                       f"{nc}:max_depth")
+    assert_one_message(compare_cli(tif, f"{nc}:max_deep"),
+                       f"{nc}:max_deep: {nc} has no map variable 'max_deep'", "max_depth")
+    assert_one_message(compare_cli(f"{tif}:max_depth", tif), f"{tif} is not a NetCDF file")
+    assert_one_message(compare_cli(tif, tmp_path / "missing.tif"), "missing.tif: no such file")
+    text = tmp_path / "notes.tif"
+    text.write_text("not a raster\n")
+    assert_one_message(compare_cli(tif, text), f"{text}: cannot read it as a raster")
+    two = tmp_path / "two.tif"
+    profile = {"driver": "GTiff", "width": 4, "height": 4, "count": 2, "dtype": "float32",
+               "crs": "EPSG:32633", "transform": from_origin(WEST, NORTH, CELL, CELL)}
+    with rasterio.open(two, "w", **profile) as dst:
+        dst.write(np.ones((2, 4, 4), dtype=np.float32))
+    assert_one_message(compare_cli(tif, two), f"{two} has 2 bands")

@@ -172,7 +172,7 @@ def test_map_files_and_no_picture_without_matplotlib(result, tmp_path, monkeypat
     from floodsph.ensemble.outputs import write_outputs
     from floodsph.output import pictures
 
-    monkeypatch.setattr(pictures, "_matplotlib", lambda: None)
+    monkeypatch.setattr(pictures, "have_matplotlib", lambda: False)
     out = tmp_path / "maps"
     out.mkdir()
     written = write_outputs(result, grid(), out, ensemble={"name": "e"}, scenario={},

@@ -17,7 +17,8 @@ from floodsph.output.envelopes import MAPS, Envelopes
 from floodsph.output.gauges import Gauges, read_gauge_file
 from floodsph.output.geotiff import write_geotiff
 from floodsph.output.grid import OutputGrid
-from floodsph.output.netcdf import SnapshotWriter
+from floodsph.output.netcdf import SnapshotWriter, write_flood_maps
+from floodsph.run_folder import PICTURE_NAMES
 from floodsph.terrain import Terrain
 
 X0, Y0, CELL = 431000.0, 5012000.0, 5.0
@@ -62,6 +63,7 @@ def test_geotiffs_read_back_north_up_with_crs_and_transform(envelopes, run_dir):
             assert src.crs == CRS_UTM
             assert src.transform == from_origin(X0, Y0 + 200.0, CELL, CELL)
             assert src.descriptions == (name,) and src.tags(1)["units"] == units
+            assert src.units == (units,)            # GDAL's band unit type
             assert src.tags()["wet_threshold_m"] == "0.05"
             assert src.profile["tiled"] and src.profile["compress"] == "deflate"
             data = src.read(1)
@@ -113,12 +115,24 @@ def test_netcdf_is_cf_and_matches_the_maps(envelopes, run_dir):
             assert var.attrs.get("cell_methods") == cell_methods
             np.testing.assert_array_equal(var.values, maps[name][::-1].astype(var.dtype))
         assert ds["hazard_uk"].attrs["flag_values"].tolist() == [0, 1, 2, 3, 4]
+        assert ds["hazard_arr"].values.max() == 5     # H5 as in the GeoTIFF
         assert ds["hazard_uk"].attrs["flag_meanings"].split()[:2] == ["dry",
                                                                       "low_hazard_caution"]
     # GDAL reads the same georeference from the NetCDF.
     with rasterio.open(f"netcdf:{run_dir / 'flood_maps.nc'}:max_depth") as src:
         assert src.crs == CRS_UTM
         assert src.transform.almost_equals(from_origin(X0, Y0 + 200.0, CELL, CELL))
+
+
+def test_netcdf_without_crs_has_no_grid_mapping(tmp_path):
+    """Synthetic terrain (no CRS): no ``crs`` variable for ``grid_mapping`` to point at."""
+    t = Terrain.from_function(lambda x, y: 0.0 * x, (0.0, 50.0), (0.0, 30.0), CELL)
+    grid = OutputGrid.from_terrain(t)
+    path = write_flood_maps(tmp_path / "m.nc", {"max_depth": np.ones(grid.shape)},
+                            {"max_depth": MAPS["max_depth"]}, grid, class_names={})
+    with xr.open_dataset(path) as ds:
+        assert "crs" not in ds.variables and "grid_mapping" not in ds["max_depth"].attrs
+        assert ds["max_depth"].attrs["standard_name"] == "flood_water_thickness"
 
 
 def test_snapshots_append_along_unlimited_time(terrain, tmp_path):
@@ -129,7 +143,9 @@ def test_snapshots_append_along_unlimited_time(terrain, tmp_path):
         w.append(0.0, d, d * 0, d * 0)
         w.append(5.0, d * 2, d * 0 + 1, d * 0)
     with xr.open_dataset(tmp_path / "snapshots.nc") as ds:
-        assert ds["time"].values.tolist() == [0.0, 5.0]
+        # seconds since the fixed reference 1970-01-01 (floodsph.output.cf.TIME_REFERENCE)
+        assert list(ds["time"].values) == [np.datetime64("1970-01-01T00:00:00"),
+                                           np.datetime64("1970-01-01T00:00:05")]
         assert ds.encoding["unlimited_dims"] == {"time"}
         np.testing.assert_array_equal(ds["depth"].values[1], (d * 2)[::-1].astype(np.float32))
         assert ds["u"].attrs["units"] == "m s-1"
@@ -161,8 +177,12 @@ def test_pictures_are_written_or_skipped_with_a_message(envelopes, tmp_path, mon
     from floodsph.output import write_pictures
 
     paths = write_pictures(envelopes, tmp_path, title="t")
-    assert sorted(p.name for p in paths) == ["arrival_time.png", "hazard_arr.png",
-                                             "hazard_uk.png", "max_depth.png"]
+    assert sorted(p.name for p in paths) == [
+        "arrival_time.png", "duration.png", "hazard_arr.png", "hazard_uk.png", "max_depth.png",
+        "max_speed.png", "max_unit_discharge.png"]
+    # Every picture is a run file, so that a later run may replace the folder.
+    assert {p.name for p in paths} == set(PICTURE_NAMES)
+    assert all(p.stat().st_size > 10_000 for p in paths)
     monkeypatch.setitem(__import__("sys").modules, "matplotlib", None)
     assert write_pictures(envelopes, tmp_path) == "pictures skipped: matplotlib not installed"
 

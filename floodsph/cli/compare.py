@@ -8,23 +8,25 @@ _FILE = click.Path(exists=True, dir_okay=False, path_type=Path)
 
 
 @click.command("compare", short_help="Compare two flood maps (CSI, hit rate, depth RMSE).")
-@click.argument("model", type=_FILE)
-@click.argument("reference", type=_FILE)
+@click.argument("model")
+@click.argument("reference")
 @click.option("--threshold", type=float, default=0.1, show_default=True,
               help="Depth [m] above which a cell is wet in both maps.")
 @click.option("--points", type=_FILE, default=None,
               help="CSV of observations (id,x,y,observed) in the map CRS.")
 @click.option("--arrival", is_flag=True,
-              help="Treat the maps as arrival times (detected from the band description "
-                   "otherwise).")
+              help="Treat the maps as arrival times (detected from the band description or "
+                   "NetCDF variable otherwise).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder for difference.tif, comparison.json and comparison.png.")
 def command(model, reference, threshold, points, arrival, out):
     """Compare MODEL with REFERENCE (a benchmark or another scenario).
 
-    REFERENCE is reprojected onto MODEL's grid (bilinear; nearest for class maps). Prints the
-    contingency counts, hit rate, false alarm ratio, CSI, F2, error bias and the depth (or
-    arrival-time) RMSE and bias over cells wet in both.
+    Each map is a single-band raster file (GeoTIFF, ASCII grid, ...) or a NetCDF variable
+    named FILE.nc:VARIABLE, e.g. out/valley/flood_maps.nc:max_depth. REFERENCE is
+    reprojected onto MODEL's grid (bilinear; nearest for class maps). Prints the contingency
+    counts, hit rate, false alarm ratio, CSI, F2, error bias and the depth (or arrival-time)
+    RMSE and bias over cells wet in both.
     """
     from floodsph.compare import compare, format_table, write_outputs
 

@@ -1,9 +1,11 @@
 """``ensemble_maps.nc``: the ensemble's maps as one CF-1.8 NetCDF file.
 
-The same conventions as the run's ``flood_maps.nc`` (``floodsph.output.netcdf``): ``y``
-north to south and ``x`` coordinates in the DEM CRS, a ``crs`` grid-mapping variable, float32
-data with ``_FillValue = NaN`` (outside the DEM), zlib level 4. The stacked maps have one more
-dimension each, with its coordinate variable:
+The same conventions as the run's ``flood_maps.nc`` (``floodsph.output.cf``): ``y`` north to
+south and ``x`` coordinates in the DEM CRS (no ``_FillValue`` on any coordinate variable), a
+``crs`` grid-mapping variable from pyproj's ``CRS.to_cf()``, float32 data with ``_FillValue =
+NaN`` (outside the DEM), zlib level 4. No CF standard name describes a probability or a
+quantile over members, so the maps carry ``long_name`` and ``units`` only. The stacked maps
+have one more dimension each, with its coordinate variable:
 
 =================  =============================  ======  ==================================
 variable           dimensions                     units   content
@@ -49,7 +51,13 @@ def write_ensemble_netcdf(path, maps: EnsembleMaps, grid, *, ensemble: dict,
     """Write ``maps`` (south-up) on ``grid`` to ``path``; returns the path."""
     import xarray as xr
 
-    from floodsph.output.netcdf import global_attrs, grid_coords, grid_mapping_attrs
+    from floodsph.output.cf import (
+        CLASS_DTYPE,
+        global_attrs,
+        grid_coords,
+        grid_mapping_attrs,
+        no_fill,
+    )
 
     path = Path(path)
     coords = grid_coords(grid)
@@ -59,13 +67,18 @@ def write_ensemble_netcdf(path, maps: EnsembleMaps, grid, *, ensemble: dict,
                                      {"long_name": "quantile probability over the members",
                                       "units": "1"})
     coords["hazard_uk_class"] = xr.Variable(
-        "hazard_uk_class", np.asarray(UK_CLASSES, np.uint8),
+        "hazard_uk_class", np.asarray(UK_CLASSES, CLASS_DTYPE),
         {"long_name": "UK flood hazard rating class (Defra/EA FD2320-FD2321)", "units": "1"})
-    data_vars = {"crs": xr.Variable((), np.int32(0), grid_mapping_attrs(grid))}
-    encoding = {"crs": {"dtype": "int32"}}
+    crs = grid_mapping_attrs(grid)
+    data_vars, encoding = {}, no_fill(coords)
+    if crs is not None:
+        data_vars["crs"] = xr.Variable((), np.int32(0), crs)
+        encoding["crs"] = {"dtype": "int32"}
     chunks = (1, min(grid.ny, 256), min(grid.nx, 256))
     for name, (dim, long_name, units) in VARIABLES.items():
-        attrs = {"long_name": long_name, "units": units, "grid_mapping": "crs"}
+        attrs = {"long_name": long_name, "units": units}
+        if crs is not None:
+            attrs["grid_mapping"] = "crs"
         if units == "1":
             attrs["valid_range"] = np.array([0.0, 1.0], np.float32)
         data = np.asarray(getattr(maps, name), dtype=np.float32)[:, ::-1, :]

@@ -52,7 +52,8 @@ def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None
 
         written.append(write_flood_maps(out_dir / "flood_maps.nc", maps, MAPS, grid,
                                         class_names=class_names, scenario=scenario,
-                                        wet_threshold=envelopes.wet_threshold))
+                                        wet_threshold=envelopes.wet_threshold,
+                                        period_s=envelopes.t_last))
     return written
 
 

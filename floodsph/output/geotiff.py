@@ -2,11 +2,12 @@
 
 Float maps: float32, NaN nodata, DEFLATE with the floating-point predictor (3). Class maps:
 uint8, 0 = dry (declared nodata so that viewers leave it transparent), a colour table and
-the class names in the band tags. Tiles of 512 x 512 and internal overviews, written with
-GDAL's ``COG`` driver when this GDAL has it (GDAL >= 3.1), else a tiled GTiff whose
-overviews are copied in with ``COPY_SRC_OVERVIEWS`` (the COG layout). The band description
-is the map name and the ``units`` tag holds its units. Rows are flipped to north-up and the
-transform is the grid's world transform in the DEM CRS.
+the class names in the band tags. The band description is the map name; its units are both
+GDAL's band unit type (rasterio's ``src.units``) and the ``units`` band tag, beside a
+``long_name`` tag. Tiles of 512 x 512 and internal overviews, written with GDAL's ``COG``
+driver when this GDAL has it (GDAL >= 3.1), else a tiled GTiff whose overviews are copied in
+with ``COPY_SRC_OVERVIEWS`` (the COG layout). Rows are flipped to north-up and the transform
+is the grid's world transform in the DEM CRS.
 
 Files are written to ``<name>.part`` and renamed, so a file of the final name is complete.
 """
@@ -95,6 +96,7 @@ def write_geotiff(path, array, grid, name: str, units: str, *, long_name: str = 
 def _fill(dst, data, name, band_tags, tags, colours, ColorInterp) -> None:
     dst.write(data, 1)
     dst.set_band_description(1, name)
+    dst.set_band_unit(1, band_tags["units"])
     dst.update_tags(1, **band_tags)
     if tags:
         dst.update_tags(**{k: str(v) for k, v in tags.items()})

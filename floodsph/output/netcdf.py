@@ -1,17 +1,13 @@
-"""CF-1.8 NetCDF writers: the envelope maps (``flood_maps.nc``) and map snapshots.
+"""NetCDF writers: the envelope maps (``flood_maps.nc``) and map snapshots (``snapshots.nc``).
 
-Layout (CF conventions 1.8, sections 4, 5.6, 7.3 and 3.5):
-
-* dimensions ``y`` (north to south, like the GeoTIFFs) and ``x``; coordinate variables with
-  ``standard_name = projection_y_coordinate / projection_x_coordinate`` and ``units = "m"``
-  holding the world coordinates of the cell centres;
-* a scalar ``crs`` grid-mapping variable with ``crs_wkt`` and ``spatial_ref`` (the WKT, as
-  GDAL reads it), ``GeoTransform`` (GDAL order) and, for transverse Mercator / UTM and
-  Lambert conformal conic CRSs, the CF ``grid_mapping_name`` and its parameters;
-* every data variable has ``long_name``, ``units`` and ``grid_mapping = "crs"``; maxima have
-  ``cell_methods = "time: maximum"``; class maps are uint8 with ``flag_values`` /
-  ``flag_meanings`` (0 = dry);
-* float maps are float32, zlib level 4, ``_FillValue = NaN``.
+Both follow CF-1.8 as set out in :mod:`floodsph.output.cf`: dimensions ``y`` (north to south,
+like the GeoTIFFs) and ``x`` with coordinate variables in the DEM CRS, a scalar ``crs``
+grid-mapping variable (when the DEM has a CRS), ``long_name`` / ``units`` / ``grid_mapping``
+on every data variable and a CF ``standard_name`` where one fits. In ``flood_maps.nc`` maxima
+have ``cell_methods = "time: maximum"``, the arrival time refers to the scalar coordinate
+``wet_threshold`` [m], the maxima's period is the scalar ``time`` with its bounds, and class
+maps are flag variables (CF ``byte``, 0 = dry). Float maps are
+float32, zlib level 4, ``_FillValue = NaN`` (never wet or outside the DEM).
 
 Global attributes: ``Conventions``, ``title``, ``source = "floodsph <version>"``,
 ``history``, ``references``, the wet threshold and the resolved scenario as a JSON string.
@@ -19,91 +15,30 @@ Global attributes: ``Conventions``, ``title``, ``source = "floodsph <version>"``
 
 from __future__ import annotations
 
-import json
 import os
-import re
-from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 
-from floodsph._version import __version__
-
-REFERENCES = ("Vacondio, Rogers, Stansby, Mignosa & Feldman (2013), Adv. Water Resour. 58, "
-              "10-23; hazard: Defra/EA FD2320-FD2321; AIDR Guideline 7-3 (2017)")
-
-
-def grid_mapping_attrs(grid) -> dict:
-    """Attributes of the ``crs`` grid-mapping variable for a grid's CRS."""
-    from rasterio.crs import CRS
-
-    t = grid.north_up_transform()
-    attrs = {"GeoTransform": " ".join(str(v) for v in (t.c, t.a, t.b, t.f, t.d, t.e))}
-    if not grid.crs_wkt:
-        return attrs
-    attrs["crs_wkt"] = grid.crs_wkt
-    attrs["spatial_ref"] = grid.crs_wkt
-    p = CRS.from_wkt(grid.crs_wkt).to_dict()
-    proj = p.get("proj")
-    if proj == "utm":
-        attrs.update(grid_mapping_name="transverse_mercator",
-                     longitude_of_central_meridian=6.0 * p["zone"] - 183.0,
-                     latitude_of_projection_origin=0.0,
-                     scale_factor_at_central_meridian=0.9996, false_easting=500000.0,
-                     false_northing=1.0e7 if p.get("south") else 0.0)
-    elif proj == "tmerc" and p.get("pm", "greenwich") == "greenwich":
-        attrs.update(grid_mapping_name="transverse_mercator",
-                     longitude_of_central_meridian=float(p.get("lon_0", 0.0)),
-                     latitude_of_projection_origin=float(p.get("lat_0", 0.0)),
-                     scale_factor_at_central_meridian=float(p.get("k", p.get("k_0", 1.0))),
-                     false_easting=float(p.get("x_0", 0.0)),
-                     false_northing=float(p.get("y_0", 0.0)))
-    elif proj == "lcc" and p.get("pm", "greenwich") == "greenwich" and "k_0" not in p:
-        attrs.update(grid_mapping_name="lambert_conformal_conic",
-                     standard_parallel=[float(p["lat_1"]), float(p.get("lat_2", p["lat_1"]))],
-                     longitude_of_central_meridian=float(p.get("lon_0", 0.0)),
-                     latitude_of_projection_origin=float(p.get("lat_0", 0.0)),
-                     false_easting=float(p.get("x_0", 0.0)),
-                     false_northing=float(p.get("y_0", 0.0)))
-    return attrs
-
-
-def grid_coords(grid) -> dict:
-    """The CF ``x`` and ``y`` coordinate variables (world cell centres, y north to south)."""
-    import xarray as xr
-
-    xw, yw = grid.world_centres()
-    x = xr.Variable("x", xw, {"standard_name": "projection_x_coordinate",
-                              "long_name": "x coordinate of the cell centre", "units": "m",
-                              "axis": "X"})
-    y = xr.Variable("y", yw, {"standard_name": "projection_y_coordinate",
-                              "long_name": "y coordinate of the cell centre", "units": "m",
-                              "axis": "Y"})
-    return {"x": x, "y": y}
-
-
-def flag_meanings(names) -> str:
-    """CF ``flag_meanings``: class names as blank-separated words (underscores inside)."""
-    return " ".join(re.sub(r"[^A-Za-z0-9]+", "_", n).strip("_").lower() for n in names)
-
-
-def global_attrs(title: str, scenario: dict | None, wet_threshold: float) -> dict:
-    """The global attributes shared by the map and snapshot files."""
-    stamp = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
-    return {
-        "Conventions": "CF-1.8",
-        "title": title,
-        "source": f"floodsph {__version__}",
-        "history": f"{stamp} written by floodsph {__version__}",
-        "references": REFERENCES,
-        "wet_threshold_m": float(wet_threshold),
-        "scenario": json.dumps(scenario or {}, sort_keys=True, default=str),
-    }
+from floodsph.output.cf import (
+    CLASS_DTYPE,
+    COORD_ATTRS,
+    THRESHOLD,
+    THRESHOLD_ATTRS,
+    TIME_ATTRS,
+    USES_THRESHOLD,
+    flag_attrs,
+    global_attrs,
+    grid_coords,
+    grid_mapping_attrs,
+    no_fill,
+    variable_attrs,
+)
 
 
 def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
                      scenario: dict | None = None, wet_threshold: float = 0.01,
-                     title: str = "floodsph flood maps") -> Path:
+                     period_s: float | None = None, title: str = "floodsph flood maps") -> Path:
     """Write the envelope maps as one CF-1.8 NetCDF file.
 
     Parameters
@@ -111,56 +46,84 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
     path : path-like
         Output file (``flood_maps.nc``).
     maps : dict name -> (ny, nx) array
-        South-up maps (row 0 = south); uint8 arrays are class maps.
+        South-up maps (row 0 = south); uint8 arrays are class maps (written as CF ``byte``).
     info : dict name -> (long_name, units, cell_methods or None)
         Metadata per map (:data:`floodsph.output.envelopes.MAPS`).
     grid : OutputGrid
         Georeference of the maps.
     class_names : dict name -> sequence of str
         Class names (index = value) of each class map.
-    scenario, wet_threshold, title
+    wet_threshold : float
+        Depth [m] above which a cell is wet: the scalar coordinate ``wet_threshold``.
+    period_s : float, optional
+        Simulated time [s] of the last update of the maps: the scalar coordinate ``time``
+        with bounds [0, period_s], the interval of the maps' ``cell_methods``.
+    scenario, title
         Recorded in the global attributes.
     """
     import xarray as xr
 
     path = Path(path)
     chunks = (min(grid.ny, 256), min(grid.nx, 256))
-    data_vars = {"crs": xr.Variable((), np.int32(0), grid_mapping_attrs(grid))}
-    encoding = {"crs": {"dtype": "int32"}}
+    crs = grid_mapping_attrs(grid)
+    coords = grid_coords(grid)
+    coords[THRESHOLD] = xr.Variable((), np.float64(wet_threshold), THRESHOLD_ATTRS)
+    data_vars = {}
+    if period_s is not None:
+        coords["time"] = xr.Variable((), np.float64(period_s),
+                                     dict(TIME_ATTRS, bounds="time_bounds"))
+        data_vars["time_bounds"] = xr.Variable("nv", np.array([0.0, period_s]))
+    encoding = no_fill([*coords, *data_vars])
+    if crs is not None:
+        data_vars["crs"] = xr.Variable((), np.int32(0), crs)
+        encoding["crs"] = {"dtype": "int32"}
     for name, arr in maps.items():
         long_name, units, cell_methods = info[name]
-        attrs = {"long_name": long_name, "units": units, "grid_mapping": "crs"}
-        if cell_methods:
-            attrs["cell_methods"] = cell_methods
+        attrs = variable_attrs(name, long_name, units, cell_methods=cell_methods,
+                               grid_mapping=crs is not None)
         if np.asarray(arr).dtype == np.uint8:
-            names = class_names[name]
-            attrs["flag_values"] = np.arange(len(names), dtype=np.uint8)
-            attrs["flag_meanings"] = flag_meanings(names)
-            data = np.asarray(arr)[::-1]
-            encoding[name] = {"dtype": "uint8", "_FillValue": None, "zlib": True,
-                              "complevel": 4, "chunksizes": chunks}
+            attrs.update(flag_attrs(class_names[name]))
+            data = np.asarray(arr, dtype=CLASS_DTYPE)[::-1]
+            encoding[name] = {"_FillValue": None}
         else:
             data = np.asarray(arr, dtype=np.float32)[::-1]
-            encoding[name] = {"dtype": "float32", "_FillValue": np.float32(np.nan),
-                              "zlib": True, "complevel": 4, "chunksizes": chunks}
+            encoding[name] = {"_FillValue": np.float32(np.nan)}
+        encoding[name].update(zlib=True, complevel=4, chunksizes=chunks)
         data_vars[name] = xr.Variable(("y", "x"), data, attrs)
-    ds = xr.Dataset(data_vars, coords=grid_coords(grid),
-                    attrs=global_attrs(title, scenario, wet_threshold))
+        names = [THRESHOLD] if name in USES_THRESHOLD else []
+        if cell_methods and period_s is not None:
+            names.append("time")
+        data_vars[name].encoding["coordinates"] = " ".join(names) or None
+    for name in ("crs", "time_bounds"):
+        if name in data_vars:
+            data_vars[name].encoding["coordinates"] = None
+    ds = xr.Dataset(data_vars, coords=coords, attrs=global_attrs(title, scenario, wet_threshold))
     part = path.with_name(path.name + ".part")
     ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
     os.replace(part, path)
     return path
 
 
+SNAPSHOT_VARIABLES = {
+    "depth": ("water depth", "m"),
+    "u": ("depth-averaged velocity, component along the projection x axis (grid east)",
+          "m s-1"),
+    "v": ("depth-averaged velocity, component along the projection y axis (grid north)",
+          "m s-1"),
+}
+"""Snapshot variable -> (long name, units)."""
+
+
 class SnapshotWriter:
     """Append depth and velocity maps at successive times to ``snapshots.nc`` (CF-1.8).
 
-    The file has an unlimited ``time`` dimension (seconds since the start of the run) and
-    variables ``depth`` [m], ``u`` and ``v`` [m/s] on (time, y, x), NaN where unsupported.
-    Use as a context manager or call :meth:`close`. ``keep_frames`` > 0 continues the frames
-    of an earlier file, ``source`` (default ``path`` itself; a resumed run): its first
-    ``keep_frames`` frames are copied into the new file, the frames after them (written after
-    the checkpoint) are dropped.
+    The file has an unlimited ``time`` dimension (seconds since the start of the run, placed
+    at :data:`floodsph.output.cf.TIME_REFERENCE`) and the variables of
+    :data:`SNAPSHOT_VARIABLES` on (time, y, x), NaN where unsupported. Use as a context
+    manager or call :meth:`close`. ``keep_frames`` > 0 continues the frames of an earlier
+    file, ``source`` (default ``path`` itself; a resumed run): its first ``keep_frames``
+    frames are copied into the new file, the frames after them (written after the
+    checkpoint) are dropped.
     """
 
     def __init__(self, path, grid, *, scenario: dict | None = None,
@@ -180,24 +143,19 @@ class SnapshotWriter:
         ds.createDimension("x", grid.nx)
         xw, yw = grid.world_centres()
         for name, values in (("x", xw), ("y", yw)):
-            var = ds.createVariable(name, "f8", (name,))
-            var.setncatts({"standard_name": f"projection_{name}_coordinate", "units": "m",
-                           "axis": name.upper()})
+            var = ds.createVariable(name, "f8", (name,), fill_value=False)
+            var.setncatts(COORD_ATTRS[name])
             var[:] = values
-        t = ds.createVariable("time", "f8", ("time",))
-        t.setncatts({"long_name": "simulated time since the start of the run", "units": "s",
-                     "axis": "T"})
-        crs = ds.createVariable("crs", "i4", ())
-        crs.setncatts(grid_mapping_attrs(grid))
+        t = ds.createVariable("time", "f8", ("time",), fill_value=False)
+        t.setncatts(TIME_ATTRS)
+        crs = grid_mapping_attrs(grid)
+        if crs is not None:
+            ds.createVariable("crs", "i4", ()).setncatts(crs)
         chunks = (1, min(grid.ny, 256), min(grid.nx, 256))
-        for name, long_name, units in (("depth", "water depth", "m"),
-                                       ("u", "depth-averaged velocity, east component",
-                                        "m s-1"),
-                                       ("v", "depth-averaged velocity, north component",
-                                        "m s-1")):
+        for name, (long_name, units) in SNAPSHOT_VARIABLES.items():
             var = ds.createVariable(name, "f4", ("time", "y", "x"), zlib=True, complevel=4,
                                     chunksizes=chunks, fill_value=np.float32(np.nan))
-            var.setncatts({"long_name": long_name, "units": units, "grid_mapping": "crs"})
+            var.setncatts(variable_attrs(name, long_name, units, grid_mapping=crs is not None))
         self._ds = ds
         if previous is not None:
             with netCDF4.Dataset(previous) as src:
