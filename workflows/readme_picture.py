@@ -3,7 +3,7 @@
 Runs ``data_samples/valley/scenario.toml`` (the synthetic valley's dam failure, 600 s) into a
 temporary run folder with ``floodsph.run.run_scenario`` and keeps the run's own quick-look
 ``hazard_uk.png`` as ``docs/images/sample_hazard.png``. Needs matplotlib
-(``pip install -e ".[plot]"``). About a minute on two cores once the kernels are compiled.
+(``pip install -e ".[plot]"``).
 
 Usage: ``python workflows/readme_picture.py [--out FILE] [--threads N]``
 """
