@@ -1,0 +1,289 @@
+"""What each key of the scenario file means: type, units, default and meaning, as named data.
+
+The parser (``floodsph.scenario``) decides which keys are accepted and checks their values;
+this module says what they are for. ``docs/scenario-reference.md`` is generated from
+:data:`TABLES` by ``python workflows/scenario_reference.py``, and
+``tests/test_scenario_reference.py`` fails when a key the parser accepts has no
+:class:`KeyDoc` here, when a key here is refused by the parser, or when the page is stale.
+
+Defaults are not repeated here: they are read from the dataclass that the parser fills
+(:attr:`TableDoc.config`), so the page shows the value a run really uses. A key whose absence
+means something other than a value (``particle_spacing_m``: the DEM cell size) says so in
+:attr:`KeyDoc.absent`.
+
+Adding a key to the parser: add its :class:`KeyDoc` to the table below, then re-run
+``python workflows/scenario_reference.py``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import MISSING, dataclass, fields
+from enum import Enum
+
+from floodsph.breach.params import BreachParams
+from floodsph.scenario import (
+    SIDES,
+    Edges,
+    Gauges,
+    Inflow,
+    InitialWater,
+    NumericsConfig,
+    OutputConfig,
+    OutputFormat,
+    Refinement,
+    ScenarioInfo,
+    Sink,
+    Stabilisation,
+    TerrainConfig,
+    TimeStepping,
+    Wall,
+)
+
+POINTS = "array of [x, y]"
+"""The type of a list of points in the DEM's CRS."""
+
+
+@dataclass(frozen=True)
+class KeyDoc:
+    """One key of a table.
+
+    name : the key as written in the TOML file.
+    type : the TOML type (``number``, ``integer``, ``string``, ``path``, ``array of [x, y]``).
+    meaning : what the key does, in a sentence or two.
+    units : SI units of the value ("" when it has none: a name, a count, a ratio).
+    required : the parser refuses the table without it.
+    absent : what leaving the key out means, when that is not its dataclass default.
+    choices : the enum whose values the key takes (shown in the type).
+    """
+
+    name: str
+    type: str
+    meaning: str
+    units: str = ""
+    required: bool = False
+    absent: str | None = None
+    choices: type[Enum] | None = None
+
+
+@dataclass(frozen=True)
+class TableDoc:
+    """One table of the scenario file and its keys.
+
+    name : the table's key path (``numerics``, ``inflows.breach``).
+    array : written ``[[name]]`` (repeatable) rather than ``[name]``.
+    meaning : what the table describes.
+    config : the dataclass the parser fills from it (holds the defaults).
+    keys : its keys, in the order the page lists them.
+    required : the file is refused without this table.
+    """
+
+    name: str
+    array: bool
+    meaning: str
+    config: type
+    keys: tuple[KeyDoc, ...]
+    required: bool = False
+
+    @property
+    def header(self) -> str:
+        return f"[[{self.name}]]" if self.array else f"[{self.name}]"
+
+    def default_text(self, key: KeyDoc) -> str:
+        """The default as TOML text (``0.3``, ``"open"``), ``required``, or what absence means."""
+        if key.required:
+            return "required"
+        if key.absent is not None:
+            return key.absent
+        found = {f.name: f for f in fields(self.config)}.get(key.name)
+        if found is None or (found.default is MISSING and found.default_factory is MISSING):
+            return "none"
+        value = found.default if found.default is not MISSING else found.default_factory()
+        return "none" if value is None else toml_text(value)
+
+    def type_text(self, key: KeyDoc) -> str:
+        """The key's type, with its allowed values when it is a choice."""
+        if key.choices is None:
+            return key.type
+        return f"{key.type}: " + " | ".join(toml_text(m) for m in key.choices)
+
+
+def toml_text(value) -> str:
+    """A default value as it would be written in the scenario file."""
+    if isinstance(value, Enum):
+        return toml_text(value.value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, tuple | list):
+        return "[" + ", ".join(toml_text(v) for v in value) + "]"
+    return repr(value)
+
+
+SCENARIO = TableDoc("scenario", False, "What the scenario is called and how long it runs.",
+                    ScenarioInfo, required=True, keys=(
+    KeyDoc("name", "string", "The scenario's name; also the default run folder, out/<name> "
+           "beside the scenario file, so no `/ \\ :` or control characters.", required=True),
+    KeyDoc("end_time_s", "number", "Simulated time at which the run ends (> 0).", "s",
+           required=True),
+    KeyDoc("description", "string", "Free text, kept in the run manifest."),
+))
+
+TERRAIN = TableDoc("terrain", False, "The ground: elevation, roughness and what happens at "
+                   "the DEM's border.", TerrainConfig, required=True, keys=(
+    KeyDoc("dem", "path", "Digital elevation model: GeoTIFF, ESRI ASCII grid (.asc, with .prj) or "
+           "NetCDF (see dem_variable). A geographic DEM is reprojected to its UTM zone.", "m",
+           required=True),
+    KeyDoc("crs", "string", "CRS of the DEM (`EPSG:27572`, a WKT or PROJ string), for a file "
+           "that carries none, such as a bare .asc.", absent="the DEM file's CRS"),
+    KeyDoc("dem_variable", "string", "Variable of a NetCDF DEM that holds the elevation.",
+           absent="the file's only raster"),
+    KeyDoc("manning", "number or path", "Manning's roughness n: one value for the whole DEM, or "
+           "a raster of n on any grid (resampled bilinearly onto the DEM). Values of 1 or more "
+           "(Strickler or Chezy coefficients) are refused.", "s m^-1/3"),
+    KeyDoc("landcover", "path", "Instead of manning: a raster of land-cover classes, mapped to n "
+           "through manning_table (nearest-neighbour resampling, classes are never averaged)."),
+    KeyDoc("manning_table", "path", "CSV with columns class, manning_n (extra columns ignored) "
+           "for landcover; required with it."),
+    KeyDoc("extent", "[xmin, ymin, xmax, ymax]", "Crop of the DEM, in its CRS.", "m",
+           absent="the whole DEM"),
+    KeyDoc("edges", "string", "`open`: water that crosses the DEM border, or reaches nodata, "
+           "leaves and is counted as outflow (waves pass out without reflection); `closed`: the "
+           "border and the nodata cells are walls.", choices=Edges),
+    KeyDoc("closed_sides", "array of strings", "With edges = \"open\": sides of the DEM "
+           f"rectangle ({', '.join(SIDES)}) that stay walls; nodata borders are then walls too."),
+))
+
+INITIAL_WATER = TableDoc("initial_water", True, "Water present at t = 0 (a reservoir, a lake): "
+                         "a level inside a polygon, or a depth raster.", InitialWater, keys=(
+    KeyDoc("level_m", "number", "Free-surface elevation: the polygon is filled wherever the bed "
+           "lies below it. Needs polygon.", "m", absent="none (give level_m + polygon or depth)"),
+    KeyDoc("polygon", POINTS, "The area to fill to level_m (at least three points, not crossing "
+           "itself), in the DEM's CRS.", "m", absent="none (required with level_m)"),
+    KeyDoc("depth", "path", "Instead of level_m + polygon: a raster of initial depth.", "m",
+           absent="none"),
+))
+
+WALLS = TableDoc("walls", True, "Lines water cannot cross (embankments, flood walls, "
+                 "buildings).", Wall, keys=(
+    KeyDoc("polyline", POINTS, "The wall's vertices in the DEM's CRS; a closed polyline (first "
+           "point = last) is a solid footprint such as a building.", "m", required=True),
+))
+
+INFLOWS = TableDoc("inflows", True, "A breach section where water enters the model, from a "
+                   "hydrograph or a parametric breach.", Inflow, keys=(
+    KeyDoc("line", POINTS, "The section's two end points; water enters across it.", "m",
+           required=True),
+    KeyDoc("hydrograph", "path", "CSV with columns time_s, discharge_m3s: the total discharge "
+           "through the section. Give this or [inflows.breach].", absent="none"),
+    KeyDoc("breach", "table", "A parametric breach turned into the hydrograph "
+           "(see [inflows.breach]).", absent="none"),
+    KeyDoc("direction", "[dx, dy]", "Direction of the entering flow (any length but zero).",
+           absent="normal to line, towards lower ground"),
+))
+
+BREACH = TableDoc("inflows.breach", False, "A parametric dam breach (Froehlich 2008 breach "
+                  "size and formation time, level-pool routing of the reservoir). Elevations "
+                  "in any consistent datum; the same keys as `floodsph breach PARAMS.toml`.",
+                  BreachParams, keys=(
+    KeyDoc("method", "string", "The breach model; Froehlich (2008) is the only one so far."),
+    KeyDoc("mode", "string", "`overtopping` (k0 = 1.3, side slopes 1.0 H:V) or `piping` (k0 = "
+           "1.0, 0.7 H:V; routed as weir flow through the same growing trapezoid)."),
+    KeyDoc("breach_height_m", "number", "h_b: the dam crest at the breach minus the final "
+           "breach invert.", "m", required=True),
+    KeyDoc("reservoir_volume_m3", "number", "V_w: the volume above the breach invert at failure; "
+           "must agree within 1 % with reservoir_area_m2 or storage_table when they are given.",
+           "m3", absent="from reservoir_area_m2 or storage_table (one of the three is required)"),
+    KeyDoc("head_m", "number", "h_w: the initial water level minus the breach invert.", "m",
+           absent="breach_height_m"),
+    KeyDoc("initial_level_m", "number", "Instead of head_m: the initial water level itself.",
+           "m", absent="none"),
+    KeyDoc("breach_invert_m", "number", "The final breach bottom elevation.", "m"),
+    KeyDoc("reservoir_area_m2", "number", "A constant reservoir surface area A, V = A (H - "
+           "invert).", "m2", absent="V_w / h_w"),
+    KeyDoc("storage_table", "path", "Instead of reservoir_area_m2: a CSV of elevation_m with "
+           "volume_m3 or area_m2 (interpolated linearly).", absent="none"),
+    KeyDoc("inflow_hydrograph", "path", "Inflow into the reservoir during the breach, CSV "
+           "time_s, discharge_m3s.", absent="none"),
+    KeyDoc("progression", "string", "How the breach grows over the formation time: `linear` or "
+           "`sine`."),
+    KeyDoc("weir_coefficient", "number", "C_w of the breach weir (side parts 2.45 / 3.1 C_w).",
+           "m^0.5 s-1"),
+    KeyDoc("average_width_m", "number", "Overrides the average breach width B_avg (for example "
+           "a sampled value in an ensemble).", "m", absent="Froehlich (2008)"),
+    KeyDoc("formation_time_s", "number", "Overrides the breach formation time t_f.", "s",
+           absent="Froehlich (2008)"),
+    KeyDoc("start_time_s", "number", "Breach initiation on the hydrograph's clock.", "s"),
+    KeyDoc("duration_s", "number", "Length of the hydrograph.", "s",
+           absent="until the outflow falls below 1e-4 of the peak after t_f"),
+    KeyDoc("dt_s", "number", "Step of the routing (RK4) and of the written hydrograph.", "s",
+           absent="min(t_f / 200, drainage time / 20)"),
+))
+
+SINKS = TableDoc("sinks", True, "Areas where water leaves the model (the sea, a lake far "
+                 "downstream); what they absorb is counted as outflow.", Sink, keys=(
+    KeyDoc("polygon", POINTS, "The area: DEM cells whose centre lies inside absorb the water "
+           "that reaches them.", "m", required=True),
+))
+
+GAUGES = TableDoc("gauges", False, "Time series of depth, level and speed at points "
+                  "(written to gauges.csv).", Gauges, keys=(
+    KeyDoc("file", "path", "CSV with columns id, x, y (the DEM's CRS).", required=True),
+    KeyDoc("interval_s", "number", "Simulated time between two samples (> 0).", "s"),
+))
+
+NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are the "
+                    "recommended values; most scenarios set particle_spacing_m only.",
+                    NumericsConfig, keys=(
+    KeyDoc("particle_spacing_m", "number", "Spacing of the particle lattice the water is "
+           "seeded on (the resolution of the run).", "m", absent="the DEM cell size"),
+    KeyDoc("cfl", "number", "Courant number of the time step dt = cfl min h / (|v| + c), in "
+           "(0, 1]."),
+    KeyDoc("refinement", "string", "Dynamic refinement: split thinning particles and coalesce "
+           "small ones (docs/method.md).", choices=Refinement),
+    KeyDoc("threads", "integer", "Threads of the numerical kernels; 0 = all cores (the "
+           "`--threads` option overrides it)."),
+    KeyDoc("kappa", "number", "Smoothing length over particle spacing, h0 / dx. At 1.2 the "
+           "square seeding lattice is a stable state of still water."),
+    KeyDoc("stabilisation", "string", "Numerical dissipation: a parameter-free Lax-Friedrichs "
+           "term or a two-shock Riemann pressure.", choices=Stabilisation),
+    KeyDoc("density_tol", "number", "Tolerance of the Newton-Raphson solve for depth and "
+           "smoothing length, on |R| / rho."),
+    KeyDoc("friction_depth_floor_m", "number", "Depth below which Manning friction is evaluated "
+           "at this depth (keeps the friction of thin films finite).", "m"),
+    KeyDoc("max_slope", "number", "Bed slopes steeper than this are limited in the bed-slope "
+           "term (dimensionless, rise over run)."),
+    KeyDoc("refine_area_max", "number", "A particle splits when its area m / rho exceeds this "
+           "many times particle_spacing_m^2."),
+    KeyDoc("refine_area_min", "number", "Particles below this many times particle_spacing_m^2 "
+           "may coalesce; must be below refine_area_max / 2."),
+    KeyDoc("refine_d_min_m", "number", "Particles shallower than this are not split.", "m"),
+    KeyDoc("refine_max_level", "integer", "At most this many generations of splitting."),
+    KeyDoc("time_stepping", "string", "`global`: one time step for every particle; `local`: "
+           "each particle at its own power-of-two multiple of the finest step (opt-in).",
+           choices=TimeStepping),
+    KeyDoc("step_levels", "integer", "With local time stepping, a big step holds at most "
+           "2^step_levels finest steps (0 to 6)."),
+))
+
+OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into it.",
+                  OutputConfig, keys=(
+    KeyDoc("directory", "path", "The run folder.", absent="out/<name> beside the scenario file"),
+    KeyDoc("resolution_m", "number", "Cell size of the output maps.", "m",
+           absent="the DEM grid (aligned to it)"),
+    KeyDoc("wet_threshold_m", "number", "A cell is wet above this depth (arrival time, duration, "
+           "extent).", "m"),
+    KeyDoc("formats", "array of strings", "Map file formats to write.", choices=OutputFormat),
+    KeyDoc("snapshot_interval_s", "number", "> 0 writes depth and velocity maps every this much "
+           "simulated time to snapshots.nc; 0 writes none.", "s"),
+    KeyDoc("mass_balance_interval_s", "number", "Simulated time between rows of "
+           "mass_balance.csv (> 0).", "s"),
+    KeyDoc("checkpoint_interval_s", "number", "> 0 writes a checkpoint at the first step at or "
+           "after each multiple of it, to resume from (`floodsph run --resume`); 0 writes none "
+           "on a schedule (a stop signal still writes one).", "s"),
+))
+
+TABLES: tuple[TableDoc, ...] = (SCENARIO, TERRAIN, INITIAL_WATER, WALLS, INFLOWS, BREACH,
+                                SINKS, GAUGES, NUMERICS, OUTPUT)
+"""Every table of the scenario file, in the order the reference lists them."""
