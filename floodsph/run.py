@@ -287,6 +287,7 @@ def build_model(scenario: Scenario, inputs):
         max_slope=num.max_slope,
         time_stepping=num.time_stepping.value,
         step_levels=num.step_levels,
+        wall_model=num.wall_model.value,
     )
     return FloodModel(
         inputs.terrain,

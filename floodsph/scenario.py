@@ -56,6 +56,14 @@ class Stabilisation(Enum):
     RIEMANN = "riemann"
 
 
+class WallModel(Enum):
+    """How walls hold water: mirror images, or the boundary integral of
+    ``floodsph.walls.shadow``."""
+
+    MIRROR = "mirror"
+    INTEGRAL = "integral"
+
+
 class OutputFormat(Enum):
     """Map file formats written at the end of a run."""
 
@@ -184,6 +192,7 @@ class NumericsConfig:
     refine_max_level: int = REFINE_DEFAULTS.max_level
     time_stepping: TimeStepping = TimeStepping.GLOBAL
     step_levels: int = 3
+    wall_model: WallModel = WallModel.MIRROR
 
 
 @dataclass(frozen=True)
@@ -553,6 +562,7 @@ def _numerics(r: Reader, data: dict) -> NumericsConfig:
         refine_max_level=r.integer(t, p, "refine_max_level", d.refine_max_level, ge=0),
         time_stepping=r.choice(t, p, "time_stepping", TimeStepping, d.time_stepping),
         step_levels=r.integer(t, p, "step_levels", d.step_levels, ge=0, le=6),
+        wall_model=r.choice(t, p, "wall_model", WallModel, d.wall_model),
     )
     if not out.refine_area_min < out.refine_area_max / 2.0:
         raise r.fail(join(p, "refine_area_min"),
