@@ -27,13 +27,13 @@ from rasterio.crs import CRS
 from rasterio.enums import Resampling
 from scipy import sparse
 
-from floodsph.boundaries.nodata_walls import walled_slivers
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
 from floodsph.io.polygons import check_polygon, points_in_polygon
 from floodsph.io.raster import read_grid, resample_onto
 from floodsph.particles import ParticleSet
 from floodsph.terrain import Terrain
+from floodsph.walls.nodata import walled_slivers
 
 LUMP_RATIO = 9.0
 """A lattice cell thinner than its deepest neighbour by this factor (h about 3 times smaller,
@@ -43,7 +43,7 @@ at equal density) gives its water to that neighbour (:func:`lump_thin_cells`).""
 def wet_cells(terrain: Terrain, walled: bool) -> np.ndarray:
     """The cells initial water may fill: the valid ones, and where the nodata border is walled
     (closed edges) the nodata slivers inside its simplified walls
-    (:func:`floodsph.boundaries.nodata_walls.walled_slivers`), which the water reaches in the
+    (:func:`floodsph.walls.nodata.walled_slivers`), which the water reaches in the
     model as well; their bed is the nearest valid elevation (``floodsph.io.dem``)."""
     if not walled:
         return terrain.valid

@@ -25,20 +25,20 @@ import math
 
 import numpy as np
 
-from floodsph import wall_seeding
-from floodsph.boundaries.junctions import split_at_junctions
-from floodsph.boundaries.nodata_walls import nodata_polylines, settle_seeds
 from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
 from floodsph.boundaries.open_edges import OpenEdges
-from floodsph.boundaries.openings import cut_openings
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.numerics import Numerics, Stabilisation, TimeStepping
+from floodsph.numerics import Numerics, Stabilisation, TimeStepping, WallModel
 from floodsph.particles import ParticleSet
 from floodsph.sph import bed as bedmod
 from floodsph.sph import consistency, density, forces, local_steps, shore
-from floodsph.sph import walls as wallmod
 from floodsph.sph.neighbours import CellGrid, NeighbourList
 from floodsph.terrain import Terrain
+from floodsph.walls import seeding as wall_seeding
+from floodsph.walls import shadow, sight
+from floodsph.walls.index import WallIndex
+from floodsph.walls.layout import model_segments
+from floodsph.walls.nodata import settle_seeds
 
 MAX_SEARCH_GROWTH = 2.0
 """Cap on the factor ``hgrow`` by which a particle's neighbour search is widened."""
@@ -56,7 +56,7 @@ class FloodModel:
         Seeded particles (local coordinates) with m, rho = rho_w d and h = kappa dx set; their
         density and smoothing length are solved on construction. Seeds of still water next to
         walls are also settled there, and their masses matched to the seeded depth
-        (``floodsph.wall_seeding``): the set is changed in place, and
+        (``floodsph.walls.seeding``): the set is changed in place, and
         ``volume_seed_adjustment`` [m3] is the volume change.
     numerics : Numerics
         The solver's settings (``floodsph.numerics``), with ``particle_spacing_m`` given.
@@ -99,15 +99,10 @@ class FloodModel:
         if open_sides:
             self.boundaries.insert(0, OpenEdges(terrain.width, terrain.height, open_sides))
         h0 = numerics.kappa * numerics.particle_spacing_m
-        segs = [wallmod.segments_from_polylines(walls),
-                _side_segments(terrain, closed, extension=6.0 * h0)]
         openings = [b.opening for b in self.boundaries if hasattr(b, "opening")]
-        if closed_edges is not False:
-            segs.append(wallmod.segments_from_polylines(
-                nodata_polylines(terrain.valid, terrain.dx, terrain.dy, openings)))
-        tol = 1e-6 * numerics.particle_spacing_m
-        self.seg = split_at_junctions(cut_openings(np.concatenate(segs), openings, tol), tol)
-        self.wall_index = wallmod.WallIndex(
+        self.seg = model_segments(terrain, walls, closed, closed_edges is not False, openings,
+                                  h0, numerics.particle_spacing_m)
+        self.wall_index = WallIndex(
             self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=2.0 * h0)
         self.t = 0.0
         self.steps = 0
@@ -122,6 +117,8 @@ class FloodModel:
         self.shores = bool(np.ptp(terrain.elevation) > 0.0)  # a flat bed has no shore to balance
         self.blocked = np.empty(0, dtype=np.bool_)
         self.wdist = np.empty(0)
+        self.integral_walls = numerics.wall_model is WallModel.INTEGRAL
+        self.walled = np.zeros(0, dtype=np.bool_)
         self._blocked_nl = None
         self._nl_fresh = False  # lists built in this step
         for boundary in self.boundaries:
@@ -227,7 +224,7 @@ class FloodModel:
         """Drift every particle by dt (walls reflect), let the open boundaries act, drop what
         left the domain, and advance density and h by the continuity guess."""
         p = self.particles
-        self.counters["wall_reflections"] += int(wallmod.drift(
+        self.counters["wall_reflections"] += int(sight.drift(
             p.x, p.y, p.u, p.v, dt, *self.walls_near[:2], self.seg))
         for boundary in self.boundaries:
             boundary.apply(self, dt)
@@ -303,7 +300,7 @@ class FloodModel:
 
     def _settle_at_walls(self, rho_seed: np.ndarray) -> float:
         """Settle the seeds of still water next to walls, then match their depth to the seeded
-        rho_seed / rho_w (``floodsph.wall_seeding``); return the volume change [m3]."""
+        rho_seed / rho_w (``floodsph.walls.seeding``); return the volume change [m3]."""
         idx = self._wall_seeds(rho_seed)
         self.counters["seeds_settled"] = int(idx.size)
         if idx.size == 0:
@@ -359,7 +356,7 @@ class FloodModel:
                and np.hypot(p.ax[idx], p.ay[idx]).max() >= wall_seeding.SETTLED * GRAVITY):
             mx[idx], my[idx] = wall_seeding.limited_move(p.ax[idx], p.ay[idx], self.stable_dt(),
                                                          p.x[idx] - x0, p.y[idx] - y0, limit)
-            wallmod.drift(p.x, p.y, mx, my, 1.0, *self.walls_near[:2], self.seg)
+            sight.drift(p.x, p.y, mx, my, 1.0, *self.walls_near[:2], self.seg)
             self._interactions(settle=True, rows=rows)
             taken += 1
         self.counters["settle_steps"] = taken
@@ -436,8 +433,18 @@ class FloodModel:
             self.blocked = np.empty(self.nl.nbr.shape[0], dtype=np.bool_)
         if self.wdist.shape[0] != self.walls_near[1].shape[0]:
             self.wdist = np.empty(self.walls_near[1].shape[0])
-        wallmod.blocked_pairs(self.nl.rows, p.x, p.y, self.nl.start, self.nl.nbr,
+        sight.blocked_pairs(self.nl.rows, p.x, p.y, self.nl.start, self.nl.nbr,
                               *self.walls_near[:2], self.seg, self.blocked, self.wdist)
+
+    def _image_lists(self):
+        """The wall arguments (wdist, wstart, wseg, cstart, cpair) of the density and force
+        kernels: with ``wall_model = "integral"`` no segment makes images (its distance
+        infinite, no corners), and the walls act through ``floodsph.walls.shadow``."""
+        wstart, wseg, cstart, cpair = self.walls_near
+        if not self.integral_walls:
+            return self.wdist, wstart, wseg, cstart, cpair
+        far = np.full(wseg.shape[0], np.inf)
+        return far, wstart, wseg, np.zeros_like(cstart), cpair[:0]
 
     def _solve_density(self, settle: bool = False) -> None:
         """The depth-density solve.
@@ -456,10 +463,11 @@ class FloodModel:
         h_predicted = p.h.copy()
         for _ in range(SETTLE_ROUNDS if settle else 2):
             self._blocked_pairs()
+            wdist, *walls = self._image_lists()
             outcome = density.solve_density(
-                p, self.nl, self.blocked, self.wdist, self.walls_near, self.seg,
+                p, self.nl, self.blocked, wdist, walls, self.seg,
                 tol=num.density_tol, max_iter=num.density_max_iter, h_ratio=num.h_ratio,
-                cap=not settle)
+                cap=not settle, integral=self.integral_walls)
             if settle and self.nl.covers(p.x, p.y, p.h):
                 break
             if not settle and (outcome.capped == 0 or self._nl_fresh):
@@ -483,29 +491,17 @@ class FloodModel:
             self._blocked_pairs()
         forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, p.kxx,
                                      p.kxy, p.kyy, self.nl.start, self.nl.nbr, self.blocked,
-                                     self.wdist, *self.walls_near, self.seg, self.scheme,
+                                     *self._image_lists(), self.seg, self.scheme,
                                      self.pair_sums, p.ax, p.ay, p.divv)
         consistency.update_renormalisation(rows, p.h, self.pair_sums, self.shores, p.kxx, p.kxy,
                                            p.kyy)
+        if self.walled.shape[0] != p.n:
+            self.walled = np.zeros(p.n, dtype=np.bool_)
+        if self.integral_walls:
+            shadow.balance_walls(rows, p.x, p.y, p.rho, p.h, *self.walls_near[:2], self.seg,
+                                      self.pair_sums, p.ax, p.ay, self.walled)
         if self.shores:
             shore.balance_shores(rows, p.x, p.y, p.u, p.v, p.rho, p.h, self.bed, t.dx, t.dy,
-                                 t.elevation, self.pair_sums, p.ax, p.ay)
+                                 t.elevation, self.pair_sums, self.walled, p.ax, p.ay)
         forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
                                     p.ay)
-
-
-def _side_segments(terrain: Terrain, closed, extension: float) -> np.ndarray:
-    """Wall segments (ns, 4) along the closed sides of the DEM rectangle.
-
-    A closed side that meets an open side runs on for ``extension`` metres beyond it, like
-    the banks of a channel that leaves the DEM: the water near that corner then sees the
-    mirror images of the outflow buffer (``OpenEdges``) too, and keeps its full depth.
-    """
-    w, h = terrain.width, terrain.height
-    e = {side: (0.0 if side in closed else extension) for side in OPEN_SIDES}
-    ends = {"south": (-e["west"], 0.0, w + e["east"], 0.0),
-            "east": (w, -e["south"], w, h + e["north"]),
-            "north": (w + e["east"], h, -e["west"], h),
-            "west": (0.0, h + e["north"], 0.0, -e["south"])}
-    return np.array([ends[side] for side in OPEN_SIDES if side in closed],
-                    dtype=np.float64).reshape(-1, 4)

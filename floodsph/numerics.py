@@ -47,6 +47,14 @@ class Stabilisation(Enum):
     RIEMANN = "riemann"
 
 
+class WallModel(Enum):
+    """How walls hold water: mirror images (``floodsph.walls.images``), or the experimental
+    boundary integral (``floodsph.walls.shadow``; measured in ``docs/still-water.md``)."""
+
+    MIRROR = "mirror"
+    INTEGRAL = "integral"
+
+
 class NumericsError(InputError, ValueError):
     """A value of :class:`Numerics` out of its bounds; ``key`` is the field (= TOML key)."""
 
@@ -98,6 +106,8 @@ class Numerics:
     time_stepping : one step for all particles, or each particle at its own power-of-two
         multiple of the finest step (``floodsph.sph.local_steps``).
     step_levels : K of local stepping: a big step holds up to 2^K finest steps.
+    wall_model : "mirror" (mirror images, the default) or "integral" (the experimental
+        boundary integral of ``floodsph.walls.shadow``).
 
     Inner tunables (not scenario keys):
 
@@ -128,6 +138,7 @@ class Numerics:
     refine_max_level: int = _setting(3, int, ge=0)
     time_stepping: TimeStepping = _setting(TimeStepping.GLOBAL, TimeStepping)
     step_levels: int = _setting(3, int, ge=0, le=6)
+    wall_model: WallModel = _setting(WallModel.MIRROR, WallModel)
     density_max_iter: int = _setting(20, int, ge=1, scenario=False)
     h_ratio: float = _setting(10.0, float, ge=1.0, scenario=False)
     neighbour_skin: float = _setting(0.1, float, ge=0.0, scenario=False)

@@ -22,21 +22,18 @@ from dataclasses import MISSING, dataclass, fields
 from enum import Enum
 
 from floodsph.breach.params import BreachParams
+from floodsph.numerics import Numerics, Refinement, Stabilisation, TimeStepping, WallModel
 from floodsph.scenario import (
     SIDES,
     Edges,
     Gauges,
     Inflow,
     InitialWater,
-    NumericsConfig,
     OutputConfig,
     OutputFormat,
-    Refinement,
     ScenarioInfo,
     Sink,
-    Stabilisation,
     TerrainConfig,
-    TimeStepping,
     Wall,
 )
 
@@ -121,6 +118,18 @@ def toml_text(value) -> str:
     return repr(value)
 
 
+VECTOR_KEYS = (
+    KeyDoc("file", "path", "A vector file whose features stand for this entry, instead of "
+           "inline coordinates: GeoJSON, or GeoPackage, shapefile or FlatGeobuf with the gis "
+           "extra; reprojected into the DEM's CRS (docs/vector-inputs.md).", absent="none"),
+    KeyDoc("layer", "string", "With file: the layer of a file that holds several.",
+           absent="the file's only layer"),
+    KeyDoc("crs", "string", "With file: the CRS of its coordinates, for a file that carries "
+           "none or to override its own.", absent="the file's CRS"),
+)
+"""Keys of an entry drawn from a vector file (``[[walls]]``, ``[[initial_water]]``, ...)."""
+
+
 SCENARIO = TableDoc("scenario", False, "What the scenario is called and how long it runs.",
                     ScenarioInfo, required=True, keys=(
     KeyDoc("name", "string", "The scenario's name; also the default run folder, out/<name> "
@@ -145,7 +154,8 @@ TERRAIN = TableDoc("terrain", False, "The ground: elevation, roughness and what 
     KeyDoc("landcover", "path", "Instead of manning: a raster of land-cover classes, mapped to n "
            "through manning_table (nearest-neighbour resampling, classes are never averaged)."),
     KeyDoc("manning_table", "path", "CSV with columns class, manning_n (extra columns ignored) "
-           "for landcover; required with it."),
+           "for landcover, or \"worldcover\" for the table shipped for ESA WorldCover classes; "
+           "required with landcover."),
     KeyDoc("extent", "[xmin, ymin, xmax, ymax]", "Crop of the DEM, in its CRS.", "m",
            absent="the whole DEM"),
     KeyDoc("edges", "string", "`open`: water that crosses the DEM border, or reaches nodata, "
@@ -160,15 +170,18 @@ INITIAL_WATER = TableDoc("initial_water", True, "Water present at t = 0 (a reser
     KeyDoc("level_m", "number", "Free-surface elevation: the polygon is filled wherever the bed "
            "lies below it. Needs polygon.", "m", absent="none (give level_m + polygon or depth)"),
     KeyDoc("polygon", POINTS, "The area to fill to level_m (at least three points, not crossing "
-           "itself), in the DEM's CRS.", "m", absent="none (required with level_m)"),
+           "itself), in the DEM's CRS.", "m", absent="none (give polygon or file with level_m)"),
     KeyDoc("depth", "path", "Instead of level_m + polygon: a raster of initial depth.", "m",
            absent="none"),
+    *VECTOR_KEYS,
 ))
 
 WALLS = TableDoc("walls", True, "Lines water cannot cross (embankments, flood walls, "
                  "buildings).", Wall, keys=(
     KeyDoc("polyline", POINTS, "The wall's vertices in the DEM's CRS; a closed polyline (first "
-           "point = last) is a solid footprint such as a building.", "m", required=True),
+           "point = last) is a solid footprint such as a building.", "m",
+           absent="none (give polyline or file)"),
+    *VECTOR_KEYS,
 ))
 
 INFLOWS = TableDoc("inflows", True, "A breach section where water enters the model, from a "
@@ -224,18 +237,26 @@ BREACH = TableDoc("inflows.breach", False, "A parametric dam breach (Froehlich 2
 SINKS = TableDoc("sinks", True, "Areas where water leaves the model (the sea, a lake far "
                  "downstream); what they absorb is counted as outflow.", Sink, keys=(
     KeyDoc("polygon", POINTS, "The area: DEM cells whose centre lies inside absorb the water "
-           "that reaches them.", "m", required=True),
+           "that reaches them.", "m", absent="none (give polygon or file)"),
+    *VECTOR_KEYS,
 ))
 
 GAUGES = TableDoc("gauges", False, "Time series of depth, level and speed at points "
                   "(written to gauges.csv).", Gauges, keys=(
-    KeyDoc("file", "path", "CSV with columns id, x, y (the DEM's CRS).", required=True),
+    KeyDoc("file", "path", "CSV with columns id, x, y (the DEM's CRS), or a vector file of "
+           "points (docs/vector-inputs.md).", required=True),
     KeyDoc("interval_s", "number", "Simulated time between two samples (> 0).", "s"),
+    KeyDoc("layer", "string", "With a vector file: the layer of a file that holds several.",
+           absent="the file's only layer"),
+    KeyDoc("crs", "string", "With a vector file: the CRS of its coordinates.",
+           absent="the file's CRS"),
+    KeyDoc("id_field", "string", "With a vector file: the attribute that names each gauge.",
+           absent="the id attribute, else the feature number from 1"),
 ))
 
 NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are the "
                     "recommended values; most scenarios set particle_spacing_m only.",
-                    NumericsConfig, keys=(
+                    Numerics, keys=(
     KeyDoc("particle_spacing_m", "number", "Spacing of the particle lattice the water is "
            "seeded on (the resolution of the run).", "m", absent="the DEM cell size"),
     KeyDoc("cfl", "number", "Courant number of the time step dt = cfl min h / (|v| + c), in "
@@ -265,6 +286,10 @@ NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are 
            choices=TimeStepping),
     KeyDoc("step_levels", "integer", "With local time stepping, a big step holds at most "
            "2^step_levels finest steps (0 to 6)."),
+    KeyDoc("wall_model", "string", "How walls, closed DEM sides and nodata banks hold water: "
+           "`mirror`, mirror images of the particles (default); `integral`, the experimental "
+           "boundary integral of the kernel support they hide (docs/still-water.md compares "
+           "the two).", choices=WallModel),
 ))
 
 OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into it.",

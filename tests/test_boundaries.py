@@ -18,7 +18,6 @@ from sph_cases import lattice, particles_with_depth, run_until
 from floodsph import testing as exact
 from floodsph.boundaries import Inflow, Sink
 from floodsph.boundaries.inflow import lattice_alpha_ratio
-from floodsph.boundaries.openings import cut_openings
 from floodsph.boundaries.riemann import critical_depth, inflow_state
 from floodsph.constants import GRAVITY
 from floodsph.errors import InputError
@@ -26,6 +25,7 @@ from floodsph.hydrograph import Hydrograph
 from floodsph.model import FloodModel
 from floodsph.numerics import Numerics
 from floodsph.terrain import Terrain
+from floodsph.walls.openings import cut_openings
 
 G = GRAVITY
 KAPPA = Numerics.kappa

@@ -4,14 +4,14 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from floodsph.boundaries import nodata_walls as nw
-from floodsph.boundaries.openings import cut_openings
 from floodsph.constants import RHO_WATER
 from floodsph.initial import seed_particles, wet_cells
 from floodsph.model import FloodModel
 from floodsph.numerics import Numerics
-from floodsph.sph import walls as wallmod
 from floodsph.terrain import Terrain
+from floodsph.walls import nodata as nw
+from floodsph.walls.geometry import segments_from_polylines
+from floodsph.walls.openings import cut_openings
 
 
 def blob(n=60, seed=3):
@@ -91,7 +91,7 @@ def test_a_digitised_disc_needs_few_chords():
 def test_settle_seeds_outside_the_walls_move_in_and_seeds_on_wall_lines_step_off():
     ok = np.ones((10, 10), dtype=bool)
     ok[:, 6:] = False  # nodata east of x = 6: the wall is the line x = 6
-    seg = wallmod.segments_from_polylines(nw.nodata_polylines(ok, 1.0, 1.0))
+    seg = segments_from_polylines(nw.nodata_polylines(ok, 1.0, 1.0))
     # beyond the wall (twice in one cell), inland, on the shore cells' corner, far out
     x = np.array([6.2, 6.7, 2.5, 5.0, 9.9])
     y = np.array([4.5, 4.2, 2.5, 3.0, 5.5])
@@ -109,7 +109,7 @@ def test_settle_seeds_keep_seeds_in_a_sliver_inside_the_walls():
     on the water's side of it, stays (unless nodata is not walled: then it moves in)."""
     yy, xx = np.mgrid[0:20, 0:20] + 0.5
     ok = yy < xx
-    seg = wallmod.segments_from_polylines(nw.nodata_polylines(ok, 1.0, 1.0))
+    seg = segments_from_polylines(nw.nodata_polylines(ok, 1.0, 1.0))
     assert seg.shape[0] <= 3  # one diagonal chord (and the ends of the chain)
     # the chord is y = x (the valid cells' outer corners); the nodata cells on the diagonal
     # are half inside: a seed in the lower half of cell (11, 11) stays, one in the upper half
@@ -142,7 +142,7 @@ def test_a_straight_nodata_edge_under_an_inflow_opening_is_kept():
     (pinned,) = nw.nodata_polylines(ok, 1.0, 1.0, [opening])
     assert [31.0, 10.0] not in free.tolist()
     assert [[31.0, 10.0], [5.0, 10.0]] == pinned[3:5].tolist()
-    cut = cut_openings(wallmod.segments_from_polylines([pinned]), [opening], 1e-6)
+    cut = cut_openings(segments_from_polylines([pinned]), [opening], 1e-6)
     assert [5.0, 10.0, 10.0, 10.0] in cut.tolist() and [20.0, 10.0, 31.0, 10.0] in cut.tolist()
 
 

@@ -395,7 +395,7 @@ def test_refined_dam_break_matches_the_fine_uniform_run_at_a_third_of_the_cost()
     """Coarse 10 m start with one level of splitting against a uniform run at the daughters'
     mass-equivalent spacing 10 / sqrt(7) m: L1 0.88 % against 0.66 %. At that spacing the
     channel's north wall lies 3.6 m beyond the last lattice row, not half a spacing; before its
-    seeds were settled (``floodsph.wall_seeding``) the uniform run's L1 was 1.83 %."""
+    seeds were settled (``floodsph.walls.seeding``) the uniform run's L1 was 1.83 %."""
     fine = cases.ritter(10.0 / math.sqrt(7.0))
     r = cases.ritter(10.0, refinement=Refinement.SPLIT_COALESCE, refine_max_level=1)
     assert r.splits > 0 and r.mass_error_rel < 1e-12

@@ -89,7 +89,7 @@ def test_a_wall_split_in_two_collinear_segments_completes_the_kernel_as_one(vert
 def test_still_water_where_walls_cross_each_other_and_the_border_stays_still():
     """Two user walls cross (an X at (200, 150) m) and run past the DEM border (each crosses a
     side of the closed box); a third ends on one of them (a T at (100, 150) m). Each junction
-    is made a shared vertex (``floodsph.boundaries.junctions``), so its right-angled corners
+    is made a shared vertex (``floodsph.walls.junctions``), so its right-angled corners
     get the point reflection and 2 m of still water in the six compartments stays still.
     Without the cuts the corner particles read 1.886 m and moved at 0.28 m/s within 5 s."""
     walls = [np.array([[-30.0, 150.0], [430.0, 150.0]]),
@@ -101,7 +101,7 @@ def test_still_water_where_walls_cross_each_other_and_the_border_stays_still():
 
 
 def test_walls_are_cut_where_they_cross_or_end_on_each_other():
-    from floodsph.boundaries.junctions import split_at_junctions
+    from floodsph.walls.junctions import split_at_junctions
 
     seg = np.array([[0.0, 0.0, 10.0, 0.0],     # cut by the T at x = 5 and the X at x = 2
                     [5.0, -5.0, 5.0, 0.0],     # ends on the first: a T, itself uncut
@@ -175,7 +175,7 @@ def test_a_dam_break_between_side_walls_stays_uniform_across_the_channel():
 
 def test_still_water_around_a_building_stays_still():
     """A closed footprint with four convex corners, aligned with the lattice. Until sight lines
-    through a vertex were settled one way (``floodsph.sph.walls.hides``), the particle on each
+    through a vertex were settled one way (``floodsph.walls.sight.hides``), the particle on each
     corner's diagonal was imaged through both faces, 4.9 % too deep, and the water moved at
     up to 1-2 m/s within 100 s."""
     building = np.array([[300.0, 200.0], [500.0, 200.0], [500.0, 400.0], [300.0, 400.0],
@@ -219,7 +219,7 @@ def test_lake_at_rest_in_a_parabolic_bowl_stays_at_rest():
 
 def test_segments_beyond_reach_are_skipped_without_changing_density_or_forces():
     """The density summation and the forces skip the images of the near segments beyond their
-    support (``wdist``, of ``floodsph.sph.walls.blocked_pairs``). With every distance set to
+    support (``wdist``, of ``floodsph.walls.sight.blocked_pairs``). With every distance set to
     zero nothing is skipped, and both give the same numbers bit for bit: on a dam break
     around a building rotated by 30 degrees, after 4 m particles have spread thin (h up to
     three times h0) and many listed segments lie beyond the support."""

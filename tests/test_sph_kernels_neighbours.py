@@ -159,7 +159,7 @@ def test_wall_lists_equal_a_brute_force_search():
     """Segments longer than the buckets, diagonal ones, radii spanning several buckets and
     the coarse levels of the bucket pyramid: every segment within reach is listed once, in
     index order, with its distance, its right-angled corners and the pairs it blocks."""
-    from floodsph.sph import walls
+    from floodsph.walls import geometry, index, sight
 
     rng = np.random.default_rng(7)
     start = rng.uniform(0.0, 400.0, (120, 2))
@@ -172,17 +172,17 @@ def test_wall_lists_equal_a_brute_force_search():
     h = rng.uniform(2.0, 40.0, n)
     h[::300] = 300.0  # lone thin particles: they and their neighbours query the coarse levels
     nl = NeighbourList(x, y, h)
-    index = walls.WallIndex(seg, (0.0, 0.0, 400.0, 400.0), bucket=15.0)
+    index = index.WallIndex(seg, (0.0, 0.0, 400.0, 400.0), bucket=15.0)
     assert index.lv_bucket.size == 6  # 15 m to 480 m buckets
     wstart, wseg, cstart, cpair = index.near_lists(x, y, h, nl.start, nl.nbr, nl.reach)
     blocked = np.empty(nl.nbr.size, dtype=np.bool_)
     wdist = np.empty(wseg.size)
-    walls.blocked_pairs(nl.rows, x, y, nl.start, nl.nbr, wstart, wseg, seg, blocked, wdist)
+    sight.blocked_pairs(nl.rows, x, y, nl.start, nl.nbr, wstart, wseg, seg, blocked, wdist)
     assert cpair.shape[0] > 50 and blocked.sum() > 100
     for i in range(0, n, 7):
         nbrs = nl.nbr[nl.start[i]:nl.start[i + 1]]
         radius = nl.reach * max(h[i], h[nbrs].max(initial=0.0))
-        dist = np.array([walls.segment_distance(x[i], y[i], *s) for s in seg])
+        dist = np.array([geometry.segment_distance(x[i], y[i], *s) for s in seg])
         near = np.flatnonzero(dist < radius)
         np.testing.assert_array_equal(wseg[wstart[i]:wstart[i + 1]], near)
         np.testing.assert_allclose(wdist[wstart[i]:wstart[i + 1]], dist[near], rtol=1e-12)
@@ -194,7 +194,7 @@ def test_wall_lists_equal_a_brute_force_search():
                                                                               - seg[b, :2]))]
         assert cpair[cstart[i]:cstart[i + 1]].tolist() == corners
         for q, j in enumerate(nbrs):
-            crossed = any(walls.crosses(x[i], y[i], x[j], y[j], *seg[s]) for s in near)
+            crossed = any(geometry.crosses(x[i], y[i], x[j], y[j], *seg[s]) for s in near)
             assert blocked[nl.start[i] + q] == crossed
 
 
@@ -202,15 +202,15 @@ def test_bucket_clearance_bounds_the_wall_distance_and_keeps_lists_exact():
     """Few walls in a large domain (one partly beyond its bounds): every point lies at least
     its bucket's ``clear`` distance from every segment, most buckets are clear, and the near
     lists that skip the walk on clear buckets still equal a brute-force search."""
-    from floodsph.sph import walls
+    from floodsph.walls import geometry, index
 
     seg = np.array([[100.0, 100.0, 300.0, 140.0], [300.0, 140.0, 320.0, 400.0],
                     [-50.0, 700.0, 150.0, 760.0], [600.0, 20.0, 610.0, 25.0]])
-    index = walls.WallIndex(seg, (0.0, 0.0, 800.0, 800.0), bucket=20.0)
+    index = index.WallIndex(seg, (0.0, 0.0, 800.0, 800.0), bucket=20.0)
     rng = np.random.default_rng(3)
     n = 4000
     x, y = rng.uniform(0.0, 800.0, n), rng.uniform(0.0, 800.0, n)
-    dist = np.array([[walls.segment_distance(x[i], y[i], *s) for s in seg] for i in range(n)])
+    dist = np.array([[geometry.segment_distance(x[i], y[i], *s) for s in seg] for i in range(n)])
     b = (y // 20.0).astype(int) * index.lv_nbx[0] + (x // 20.0).astype(int)
     assert np.all(dist.min(axis=1) >= index.clear[b])
     assert np.mean(index.clear > 0.0) > 0.7

@@ -1,5 +1,5 @@
 """Seeds next to oblique walls: settled and matched to the seeded depth at set-up
-(``floodsph.wall_seeding``), so that still water along such walls stays still."""
+(``floodsph.walls.seeding``), so that still water along such walls stays still."""
 
 from pathlib import Path
 
@@ -8,11 +8,12 @@ import pytest
 from conftest import load_workflow
 from sph_cases import lattice, model_on, run_until
 
-from floodsph import wall_seeding
 from floodsph.constants import RHO_WATER
 from floodsph.model import FloodModel
 from floodsph.numerics import Numerics
-from floodsph.sph import walls as wallmod
+from floodsph.walls import seeding as wall_seeding
+from floodsph.walls.geometry import segments_from_polylines
+from floodsph.walls.index import WallIndex
 
 STILL = load_workflow("still_water_at_walls",
                       Path(__file__).parents[1] / "workflows" / "still_water_at_walls.py")
@@ -106,8 +107,8 @@ def test_seeds_whose_support_reaches_dry_ground_are_not_enclosed():
     x, y = lattice(0.0, 200.0, 0.0, 200.0, dx)
     wet = (x > 51.0) & (y < 100.0)
     x, y = x[wet], y[wet]
-    seg = wallmod.segments_from_polylines([np.array([[51.0, -10.0], [51.0, 210.0]])])
-    index = wallmod.WallIndex(seg, (0.0, 0.0, 200.0, 200.0), bucket=2.0 * h)
+    seg = segments_from_polylines([np.array([[51.0, -10.0], [51.0, 210.0]])])
+    index = WallIndex(seg, (0.0, 0.0, 200.0, 200.0), bucket=2.0 * h)
     n = x.size
     reach = wall_seeding.ENCLOSURE * h
     wstart, wseg = index.near_lists(x, y, np.full(n, h), np.zeros(n + 1, dtype=np.int64),

@@ -193,10 +193,10 @@ def test_malpasset_points_read_back(tmp_path):
 def test_malpasset_sea_modes_differ_by_the_cells_below_sea_level(tmp_path):
     import rasterio
 
-    from floodsph.boundaries.nodata_walls import walled_slivers
     from floodsph.inputs import prepare_inputs
     from floodsph.io.polygons import points_in_polygon
     from floodsph.scenario import load_scenario
+    from floodsph.walls.nodata import walled_slivers
 
     inputs = {}
     for sea in mp_setup.SEA_MODES:
@@ -265,7 +265,7 @@ def test_malpasset_two_steps_reservoir_sea_and_no_arrival(malpasset_run):
     sea = bed < -1.0
     # The median sits 0.1-0.2 m low: near the nodata border the kernel is completed by
     # mirror images about walls that run up to a cell outside the DEM's staircase
-    # (floodsph.boundaries.nodata_walls), so near-wall depths start slightly low.
+    # (floodsph.walls.nodata), so near-wall depths start slightly low.
     assert np.median(level[reservoir]) == pytest.approx(100.0, abs=0.25)
     assert np.median(level[sea]) == pytest.approx(0.0, abs=0.2)
     points = _rows(out / "particles" / "points.csv")

@@ -406,6 +406,17 @@ def build_cases(kinds, folder: Path, quick: bool, end_times: dict) -> list[cases
     return out
 
 
+def set_wall_model(case: cases.Case, wall_model: str) -> None:
+    """Write ``[numerics] wall_model`` into the case's scenario file."""
+    import tomllib
+
+    import tomli_w
+
+    data = tomllib.loads(case.scenario.read_text(encoding="utf-8"))
+    data.setdefault("numerics", {})["wall_model"] = wall_model
+    case.scenario.write_text(tomli_w.dumps(data), encoding="utf-8")
+
+
 def end_times(args) -> dict:
     """Each kind's end time [s]: the default (or quick) one times ``--time-scale``, unless
     ``--end-time KIND=SECONDS`` sets it."""
@@ -442,6 +453,8 @@ def run_benchmark(args) -> Benchmark:
     kinds = args.cases or [k for k in KINDS if not (args.quick and k == "malpasset")]
     runs = []
     for case in build_cases(kinds, args.out / "scenarios", args.quick, end_times(args)):
+        if args.wall_model:
+            set_wall_model(case, args.wall_model)
         runs.append(run_case(case, args.out / "runs" / case.scenario.parent.name))
         print(f"{case.label}: done, {runs[-1].manifest['wall_time_s']:.1f} s", flush=True)
     command = " ".join(["NUMBA_NUM_THREADS=" + os.environ.get("NUMBA_NUM_THREADS", "(all)"),
@@ -600,6 +613,8 @@ def parse_args(argv=None):
     ap.add_argument("--end-time", nargs="+", metavar="CASE=SECONDS",
                     help="end times of single cases (over --time-scale)")
     ap.add_argument("--quick", action="store_true", help="tiny, short synthetic cases")
+    ap.add_argument("--wall-model", choices=("mirror", "integral"),
+                    help="[numerics] wall_model of every case (default: the scenario default)")
     ap.add_argument("--out", type=Path, default=Path("results/still_water"))
     ap.add_argument("--doc", type=Path, help="the report (default docs/still-water.md; with "
                     "--quick <out>/still-water.md)")

@@ -1,5 +1,5 @@
 """Still water next to walls that do not run along the seeding lattice, with and without the
-set-up of ``floodsph.wall_seeding`` (seeds settled, masses matched to the seeded depth).
+set-up of ``floodsph.walls.seeding`` (seeds settled, masses matched to the seeded depth).
 
 Cases (flat, frictionless beds; walls as ``FloodModel(walls=...)`` polylines):
 
@@ -32,12 +32,13 @@ import time
 import numpy as np
 from matplotlib.path import Path
 
-from floodsph import verification, wall_seeding
+from floodsph import verification
 from floodsph.constants import RHO_WATER
 from floodsph.model import FloodModel
 from floodsph.numerics import Numerics
 from floodsph.particles import ParticleSet
 from floodsph.terrain import Terrain
+from floodsph.walls import seeding as wall_seeding
 
 CASES = ("turned-rectangle", "turned-building", "large-building", "ritter-3.78m")
 

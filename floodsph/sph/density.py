@@ -25,7 +25,7 @@ spurious root of (1)-(2) at a tiny h, where that neighbour's W(r, h) is near its
 solve fell into it (in a refined dam break a 0.42 m deep particle became 30 m deep with
 h = 0.9 m instead of 7.5 m in one step, and was shot off at 38 m/s, twice the bound
 2 sqrt(g d0)); held at the bound, the pair repels and separates over the next steps.
-Mirror images across walls (``floodsph.sph.walls``) are part of the summation.
+Mirror images across walls (``floodsph.walls``) are part of the summation.
 """
 
 from __future__ import annotations
@@ -37,7 +37,9 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import w_cubic, w_dwdr_cubic
-from floodsph.sph.walls import SIGHT_SLACK, corner_image, wall_image
+from floodsph.walls.images import corner_image, wall_image
+from floodsph.walls.shadow import shadow
+from floodsph.walls.sight import SIGHT_SLACK
 
 H_SHRINK_MIN = 0.8
 """In a time step, h_i >= H_SHRINK_MIN h_i(guess), i.e. rho_i at most 1.56 times its continuity
@@ -56,7 +58,7 @@ def _pair(rx, ry, mj, hi):
 @njit(inline="always", cache=True)
 def _image(i, j, x, y, m, hi, seg, s):
     """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's mirror image across segment s
-    (x_j' = 2 f_j - x_j, ``floodsph.sph.walls.wall_image``) seen from i; (0, 0) when the wall
+    (x_j' = 2 f_j - x_j, ``floodsph.walls.images.wall_image``) seen from i; (0, 0) when the wall
     does not hide that image's point from i (MVBP mirror particles, method notes 3.1)."""
     xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
     if not ok:
@@ -67,7 +69,7 @@ def _image(i, j, x, y, m, hi, seg, s):
 @njit(inline="always", cache=True)
 def _corner(i, j, x, y, m, hi, seg, s1, s2):
     """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's point reflection through the
-    right-angled corner of segments s1 and s2 (``floodsph.sph.walls.corner_image``) seen from
+    right-angled corner of segments s1 and s2 (``floodsph.walls.images.corner_image``) seen from
     i; (0, 0) when that image does not apply (method notes 3.1)."""
     xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
     if not ok:
@@ -81,7 +83,7 @@ def summation(i, hi, x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
 
     Returns (sum_j m_j W(r_ij, h_i), alpha_i), self and mirror images included; listed
     neighbours beyond the support 2 h_i are skipped (W = 0 there). Pairs flagged in
-    ``blocked`` (:func:`floodsph.sph.walls.blocked_pairs`) are left out with their images.
+    ``blocked`` (:func:`floodsph.walls.sight.blocked_pairs`) are left out with their images.
     A segment farther than 2 h_i from i (``wdist``, of the same function) makes no image
     within the support, so its single images are skipped (the sum is unchanged).
     Images are summed segment by segment, each segment followed by the corners it opens
@@ -128,6 +130,26 @@ def summation(i, hi, x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
     return rsum, alpha
 
 
+GAMMA_MIN = 0.25
+"""Least water fraction gamma = 1 - S of a support (``floodsph.walls.shadow``) that the
+depth is corrected by: a particle pressed into a corner (gamma 0.25 at the vertex of a right
+angle) is not made deeper still."""
+
+
+@njit(inline="always", cache=True)
+def wall_corrected(i, hi, rsum, alpha, x, y, wstart, wseg, seg):
+    """The summation (1) and alpha_i of particle i divided by the water fraction of its support,
+    gamma_i = 1 - S_i(h_i) (``floodsph.walls.shadow.shadow``, at least ``GAMMA_MIN``):
+    rho_i = sum_j m_j W(r_ij, h_i) / gamma_i, the depth of water that fills the support up to the
+    walls (Ferrand et al., IJNMF 71 (2013) 446-472, eq. 13). alpha_i is divided alike; the
+    derivative of gamma in h is left out of it (the Newton update (3) then converges linearly
+    next to walls; its residual is exact)."""
+    if wstart[i + 1] == wstart[i]:
+        return rsum, alpha
+    gamma = max(1.0 - shadow(x[i], y[i], hi, wstart[i], wstart[i + 1], wseg, seg), GAMMA_MIN)
+    return rsum / gamma, alpha / gamma
+
+
 @njit(inline="always", cache=True)
 def _h_of_rho(h0, rho0, rho, h_ratio):
     """h = h0 (rho0 / rho)^(1/2) of (2) [m], kept within [h0 / h_ratio, h0 h_ratio]."""
@@ -136,7 +158,7 @@ def _h_of_rho(h0, rho0, rho, h_ratio):
 
 @njit(parallel=True, cache=True)
 def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, wstart, wseg,
-          cstart, cpair, seg, tol, max_iter, h_ratio, h_cap, h_shrink, iters):
+          cstart, cpair, seg, tol, max_iter, h_ratio, h_cap, h_shrink, integral, iters):
     """Newton-Raphson solve (1)-(3) of the particles ``rows``, in place (gather form).
 
     Only h_i changes the summation of particle i, so each particle iterates on its own to
@@ -167,6 +189,8 @@ def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, w
         while it < max_iter and not capped and not held:
             s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
                              cpair, seg)
+            if integral:
+                s, a = wall_corrected(i, h[i], s, a, x, y, wstart, wseg, seg)
             alpha[i] = a
             it += 1
             res = rho[i] - s
@@ -186,6 +210,8 @@ def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, w
         else:
             s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
                              cpair, seg)
+            if integral:
+                s, a = wall_corrected(i, h[i], s, a, x, y, wstart, wseg, seg)
             rho[i] = s
             alpha[i] = a
             iters[i] = 0 if capped else (max_iter + 1 if held else -it)
@@ -201,14 +227,14 @@ def predict(rho, h, divv, dt):
 
 
 def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0,
-                  cap=False):
+                  cap=False, integral=False):
     """Solve (1)-(3) in place for the particles of ``p`` that ``nl`` lists (``nl.rows``).
 
     ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList;
     ``blocked`` its pairs separated by a wall and ``wdist`` the distances to the near
-    segments (both from :func:`floodsph.sph.walls.blocked_pairs`); ``walls`` the near-wall
+    segments (both from :func:`floodsph.walls.sight.blocked_pairs`); ``walls`` the near-wall
     lists (wstart, wseg, cstart, cpair) of
-    :meth:`floodsph.sph.walls.WallIndex.near_lists`; ``seg`` the wall segments.
+    :meth:`floodsph.walls.index.WallIndex.near_lists`; ``seg`` the wall segments.
     With ``cap`` (a time step), no h grows beyond what ``nl`` holds (:meth:`NeighbourList.h_cap`),
     so the lists stay valid through the solve, and none shrinks below ``H_SHRINK_MIN`` times its
     guess (see the module docstring).
@@ -219,7 +245,8 @@ def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ra
     iters = np.ones(p.n, dtype=np.int64)  # rows not solved count as converged
     h_cap = nl.h_cap(p.x, p.y) if cap else np.full(p.n, np.inf)
     solve(nl.rows, p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked,
-          wdist, *walls, seg, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, iters)
+          wdist, *walls, seg, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0,
+          integral, iters)
     held = iters > max_iter
     return DensityOutcome(iterations=int(np.abs(np.where(held, 0, iters)).max(initial=0)),
                           unconverged=int((iters < 0).sum()), capped=int((iters == 0).sum()),

@@ -20,7 +20,7 @@ have left the lattice (``floodsph.sph.consistency``). All these forms are antisy
 (i, j): internal forces conserve linear momentum exactly. The same loop sums
 the hydrostatic pressure's parts that ``floodsph.sph.consistency`` renormalises with and that
 ``floodsph.sph.shore`` uses to balance it where the water ends on a rising bed.
-Wall images (``floodsph.sph.walls``) enter the same pair terms; a particle's own images
+Wall images (``floodsph.walls``) enter the same pair terms; a particle's own images
 (across a wall, normal to it, and through a corner) with the kernel gradient held at its peak
 below q = r/h = 2/3 (:func:`floodsph.sph.kernels.dwdr_over_r_floored`). With the plain cubic
 the push of a particle's own image, at twice its distance to the wall, fades as the particle
@@ -53,7 +53,9 @@ from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.kernels import dwdr_over_r_cubic, dwdr_over_r_floored
-from floodsph.sph.walls import SIGHT_SLACK, corner_image, mirror, wall_image
+from floodsph.walls.geometry import mirror
+from floodsph.walls.images import corner_image, wall_image
+from floodsph.walls.sight import SIGHT_SLACK
 
 LAX_FRIEDRICHS = 0
 RIEMANN = 1
@@ -156,11 +158,11 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nst
     """a^int and div v of the particles ``rows`` (gather form), mirror images included.
 
     Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
-    flagged in ``blocked`` (:func:`floodsph.sph.walls.blocked_pairs`) are left out with
+    flagged in ``blocked`` (:func:`floodsph.walls.sight.blocked_pairs`) are left out with
     their images, and a segment's single images skip the neighbours j whose pair support
     2 max(h_i, h_j) does not reach it (``wdist``, of the same function). The wall lists
     (wstart, wseg, cstart, cpair) are those of
-    :meth:`floodsph.sph.walls.WallIndex.near_lists`; images are summed segment by segment,
+    :meth:`floodsph.walls.index.WallIndex.near_lists`; images are summed segment by segment,
     each followed by the corners it opens, as in the density summation.
 
     Row i of ``sums`` (n, SUMS) receives particle i's sums of :func:`_subtract` (columns 2-8,

@@ -45,7 +45,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import SIGMA_2D, w_cubic
-from floodsph.sph.walls import crosses
+from floodsph.walls.geometry import crosses
 
 VERTEX_FRACTION = 0.136882287617319
 """Mass of each of the six hexagon daughters over the parent's mass [V12-split]."""
@@ -96,7 +96,7 @@ def daughters_clear(xp, yp, x, y, wstart, wseg, seg, out):
     """out[k] = True when no wall segment separates parent k from any of its 7 daughters.
 
     ``(wstart, wseg)`` lists the segments near each parent, within its hexagon's radius
-    (``floodsph.sph.walls.WallIndex.near_lists``); a segment that crosses the line from the
+    (``floodsph.walls.index.WallIndex.near_lists``); a segment that crosses the line from the
     parent to a daughter is among them.
     """
     for k in prange(xp.shape[0]):

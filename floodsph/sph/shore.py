@@ -73,17 +73,20 @@ def moment_matrix(sums, i):
 
 
 @njit(parallel=True, cache=True)
-def balance_shores(rows, x, y, u, v, rho, h, bed, dx, dy, elevation, sums, ax, ay):
+def balance_shores(rows, x, y, u, v, rho, h, bed, dx, dy, elevation, sums, walled, ax, ay):
     """Correct a^int (``ax``, ``ay``) of the particles ``rows`` at shores (module docstring).
 
     ``sums`` holds their D, E and g M (columns 0-1, 2-3, 4-6, of
     ``floodsph.sph.forces.internal_acceleration``); velocities u, v [m s-1]; ``bed`` is the
     (n, 7) sample of ``floodsph.sph.bed.sample_bed`` (column 0, b_i [m]); ``elevation`` the
-    node-centred DEM grid with spacings dx, dy [m].
+    node-centred DEM grid with spacings dx, dy [m]; particles flagged in ``walled`` are left
+    alone (their force is the wall's, ``floodsph.walls.shadow.balance_walls``).
     """
     ny, nx = elevation.shape
     for k in prange(rows.shape[0]):
         i = rows[k]
+        if walled[i]:
+            continue
         ex = sums[i, 2]
         ey = sums[i, 3]
         e = math.sqrt(ex * ex + ey * ey)

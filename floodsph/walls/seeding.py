@@ -3,7 +3,7 @@
 Water is seeded on a square lattice of spacing dx with m_i = rho_w d_i dx^2
 (``floodsph.initial``). In a full kernel support the SPH depth of such a lattice is the
 seeded d, and still water is an equilibrium (method notes 1.4). Next to a wall the mirror
-images (``floodsph.sph.walls``) complete the support exactly only where the lattice rows run
+images (``floodsph.walls``) complete the support exactly only where the lattice rows run
 along the wall, half a spacing from it. Along an oblique wall (a nodata chord, a user's
 embankment) the seeds lie at every distance from it, and their images crowd them or leave
 gaps. In a frictionless 2 m lake held by a rectangle of walls turned by 30 degrees (5 m
@@ -73,7 +73,7 @@ import numpy as np
 from numba import njit, prange
 from scipy.spatial import cKDTree
 
-from floodsph.sph.walls import crosses
+from floodsph.walls.geometry import crosses
 
 SETTLE_STEPS = 300
 """Largest number of settling rounds (each one density and force evaluation)."""

@@ -1,36 +1,11 @@
-"""Closed boundaries as wall segments: mirror particles, pair blocking and a crossing guard.
+"""Near-wall lists: which wall segments lie within each particle's reach.
 
-A wall is a polyline (a closed one is a solid footprint); the DEM border is four of them when
-the edges are closed. Three mechanisms keep water on its side:
-
-1. **Mirror particles.** For a particle i near a wall segment, every neighbour j on i's side
-   (i itself included) contributes a mirror image x_j' = 2 f_j - x_j (f_j its foot on the
-   segment's line), with the same mass, density, alpha and h and the mirrored velocity
-   v_j' = v_j - 2 (v_j . n) n (free slip), if the line from i to the image passes through the
-   segment: the images fill the part of i's support hidden from i behind the wall. On a
-   straight wall this completes the kernel exactly, so the depth and the pressure of still
-   water along a wall are those of the interior (zero-order consistency, the property the
-   modified virtual boundary particles of Vacondio, Rogers & Stansby, IJNMF 69 (2012) 226-253
-   approximate). Behind a convex corner (a building's) each hidden point is imaged once, by
-   the face the line passes through. j's foot need not fall on the segment: where a wall
-   bends, a point hidden behind one segment may be the image of a particle in front of the
-   next (an earlier version required the foot on the segment, and lost those images near every
-   vertex of a polyline). A sight line exactly through a vertex is settled by a fixed shift of
-   1e-7 m (:func:`hides`), so that point is imaged once. In a right-angled corner where two
-   near segments meet, j's foot on both gives a third image, the reflection of j's first image
-   about the second wall (the point reflection through the corner), which completes the kernel
-   there too.
-2. **Pair blocking.** Particles on opposite sides of a wall do not interact.
-3. **Crossing guard.** A drift step that would cross a wall is reflected about it (position and
-   normal velocity), so no particle ever crosses, whatever the time step (:func:`drift`).
-
-Near-wall lists are CSR arrays ``(wstart, wseg)`` built with the neighbour lists, with the
-same skin, for the particles within the interaction radius of a segment (and kept as long as
-the neighbour lists are: a wall within the support now was within the skinned radius at the
-build), together with each particle's corners ``(cstart, cpair)``: the pairs of its near
-segments that meet at a right angle, listed in ``wseg`` order. Most particles have none and pay
-nothing. Which listed pairs a wall separates is found once per step (:func:`blocked_pairs`)
-for the density iterations and the forces.
+:class:`WallIndex` buckets the static wall segments on a pyramid of grids; its
+:meth:`WallIndex.near_lists` gives each particle's near segments (CSR arrays
+``(wstart, wseg)``), built with the neighbour lists and the same skin, and each particle's
+right-angled corners ``(cstart, cpair)``: the pairs of its near segments that meet at a right
+angle, listed in ``wseg`` order (the corners that make double mirror images). Most particles
+have none and pay nothing.
 """
 
 from __future__ import annotations
@@ -41,21 +16,7 @@ import numpy as np
 from numba import njit, prange
 from scipy import ndimage
 
-
-def segments_from_polylines(polylines) -> np.ndarray:
-    """Stack polylines ((k, 2) arrays, local metres) into segments (ns, 4): x1, y1, x2, y2."""
-    segs = []
-    for line in polylines:
-        pts = np.asarray(line, dtype=np.float64)
-        for a, b in zip(pts[:-1], pts[1:], strict=True):
-            if np.hypot(*(b - a)) > 0.0:
-                segs.append((a[0], a[1], b[0], b[1]))
-    return np.asarray(segs, dtype=np.float64).reshape(-1, 4)
-
-
-def box_polyline(xmin, ymin, xmax, ymax) -> np.ndarray:
-    """A closed rectangle as a polyline (the DEM border of a closed domain)."""
-    return np.array([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax], [xmin, ymin]])
+from floodsph.walls.geometry import segment_distance
 
 
 class WallIndex:
@@ -174,16 +135,6 @@ def _clearance(occupied: np.ndarray, bucket: float) -> np.ndarray:
         return np.full(occupied.size, np.inf)
     e = ndimage.distance_transform_edt(~occupied)
     return (bucket * np.maximum(e - math.sqrt(2.0), 0.0)).ravel()
-
-
-@njit(inline="always", cache=True)
-def segment_distance(px, py, x1, y1, x2, y2):
-    """Distance [m] from point p to the segment (x1, y1)-(x2, y2)."""
-    ex = x2 - x1
-    ey = y2 - y1
-    t = ((px - x1) * ex + (py - y1) * ey) / (ex * ex + ey * ey)
-    t = min(max(t, 0.0), 1.0)
-    return math.hypot(px - x1 - t * ex, py - y1 - t * ey)
 
 
 @njit(inline="always", cache=True)
@@ -350,164 +301,3 @@ def _corner_scan(wstart, wseg, pstart, partner, cstart, cpair, fill):
                     k += 1
         if not fill:
             cstart[i + 1] = k
-
-
-@njit(inline="always", cache=True)
-def crosses(ax, ay, bx, by, x1, y1, x2, y2):
-    """True if the segment a-b meets the wall segment (x1, y1)-(x2, y2)."""
-    dx = bx - ax
-    dy = by - ay
-    ex = x2 - x1
-    ey = y2 - y1
-    den = dx * ey - dy * ex
-    if den == 0.0:
-        return False
-    qx = x1 - ax
-    qy = y1 - ay
-    t = (qx * ey - qy * ex) / den
-    s = (qx * dy - qy * dx) / den
-    return 0.0 <= t <= 1.0 and 0.0 <= s <= 1.0
-
-
-TIE_SHIFT = (0.6e-7, 0.8e-7)
-"""Offset [m] of the sight lines of :func:`hides` (a fixed direction, 1e-7 m long)."""
-
-
-@njit(inline="always", cache=True)
-def hides(ax, ay, bx, by, seg, s):
-    """True if segment s lies across the sight line from a to b.
-
-    The test is :func:`crosses` on the line shifted by ``TIE_SHIFT``: a line through an end
-    point of s, such as a vertex two segments share (common where vertices lie on DEM cell
-    corners and particles on cell centres), then passes on one definite side of it. Pair
-    blocking and the mirror images use this one test, so a hidden point is imaged through one
-    segment only, and a neighbour is either seen or replaced by its image, never both.
-    """
-    dx, dy = TIE_SHIFT
-    return crosses(ax + dx, ay + dy, bx + dx, by + dy, seg[s, 0], seg[s, 1], seg[s, 2],
-                   seg[s, 3])
-
-
-SIGHT_SLACK = 1e-6
-"""Slack [m] of the distance tests that skip far segments: a segment that :func:`hides` a
-point at distance r from particle i lies within r + |TIE_SHIFT| (1e-7 m) of i, so one
-farther than r + SIGHT_SLACK neither blocks the pair nor makes an image within r (the margin
-also covers rounding, ~1e-10 m at 1e5 m from the origin)."""
-
-
-@njit(parallel=True, cache=True)
-def blocked_pairs(rows, x, y, nstart, nbr, wstart, wseg, seg, out, wdist):
-    """out[q] = True when a wall near particle i separates it from its neighbour nbr[q], for
-    the particles i in ``rows`` (those whose neighbours are listed).
-
-    Also ``wdist[k]``, the distance [m] from particle i to its near segment wseg[k]: a segment
-    farther from i than r_ij + SIGHT_SLACK cannot hide j (:func:`hides`), and the density
-    summation and the forces skip the images of segments beyond their support the same way.
-    Computed once per step (positions fixed) for the density iterations and the forces, which
-    then skip blocked pairs and their mirror images at the cost of a lookup.
-    """
-    for r in prange(rows.shape[0]):
-        i = rows[r]
-        xi = x[i]
-        yi = y[i]
-        nearest = np.inf
-        for k in range(wstart[i], wstart[i + 1]):
-            s = wseg[k]
-            wdist[k] = segment_distance(xi, yi, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-            nearest = min(nearest, wdist[k])
-        if wstart[i + 1] == wstart[i]:
-            out[nstart[i]:nstart[i + 1]] = False
-            continue
-        for q in range(nstart[i], nstart[i + 1]):
-            j = nbr[q]
-            rx = xi - x[j]
-            ry = yi - y[j]
-            reach = math.sqrt(rx * rx + ry * ry) + SIGHT_SLACK
-            hit = False
-            if reach >= nearest:  # else no segment is that close, and none hides j
-                for k in range(wstart[i], wstart[i + 1]):
-                    if wdist[k] <= reach and hides(xi, yi, x[j], y[j], seg, wseg[k]):
-                        hit = True
-                        break
-            out[q] = hit
-
-
-@njit(inline="always", cache=True)
-def mirror(px, py, x1, y1, x2, y2):
-    """Mirror image of p about the wall's line, and whether p's foot lies on the segment.
-
-    Returns (x', y', on_segment, nx, ny) with (nx, ny) the unit normal of the wall.
-    """
-    ex = x2 - x1
-    ey = y2 - y1
-    ll = ex * ex + ey * ey
-    t = ((px - x1) * ex + (py - y1) * ey) / ll
-    fx = x1 + t * ex
-    fy = y1 + t * ey
-    inv = 1.0 / math.sqrt(ll)
-    return 2.0 * fx - px, 2.0 * fy - py, 0.0 <= t <= 1.0, -ey * inv, ex * inv
-
-
-@njit(inline="always", cache=True)
-def wall_image(xi, yi, px, py, seg, s):
-    """Mirror image of p about segment s as seen from particle i: (x', y', ok).
-
-    ok: s hides the image from i (:func:`hides`: the line from i to it passes through the
-    segment); p's foot may fall beyond the segment's ends.
-    """
-    xm, ym, _, _, _ = mirror(px, py, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-    ok = hides(xi, yi, xm, ym, seg, s)
-    return xm, ym, ok
-
-
-@njit(inline="always", cache=True)
-def corner_image(px, py, seg, s1, s2):
-    """Double mirror image of p about segments s1 then s2, which share a vertex.
-
-    Returns (x'', y'', ok): ok is False unless p's foot lies on both segments.
-    """
-    x1, y1, on1, _, _ = mirror(px, py, seg[s1, 0], seg[s1, 1], seg[s1, 2], seg[s1, 3])
-    _, _, on2, _, _ = mirror(px, py, seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
-    x2, y2, _, _, _ = mirror(x1, y1, seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
-    return x2, y2, on1 and on2
-
-
-@njit(parallel=True, cache=True)
-def drift(x, y, u, v, dt, wstart, wseg, seg):
-    """Drift x <- x + dt v, reflecting moves that cross a wall. Returns the reflection count.
-
-    A move x_old -> x that meets a segment of the particle's near-wall list is mirrored about
-    the segment's line and the velocity's normal component reversed; after three reflections
-    (a corner) the particle is put back to x_old with zero velocity.
-    """
-    total = 0
-    for i in prange(x.shape[0]):
-        x_old = x[i]
-        y_old = y[i]
-        x[i] = x_old + dt * u[i]
-        y[i] = y_old + dt * v[i]
-        hits = 0
-        for _ in range(3):
-            hit = -1
-            for k in range(wstart[i], wstart[i + 1]):
-                s = wseg[k]
-                if crosses(x_old, y_old, x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]):
-                    hit = s
-                    break
-            if hit < 0:
-                break
-            hits += 1
-            xm, ym, _, nx, ny = mirror(x[i], y[i], seg[hit, 0], seg[hit, 1], seg[hit, 2],
-                                       seg[hit, 3])
-            x[i] = xm
-            y[i] = ym
-            vn = u[i] * nx + v[i] * ny
-            u[i] -= 2.0 * vn * nx
-            v[i] -= 2.0 * vn * ny
-        if hits >= 3:
-            x[i] = x_old
-            y[i] = y_old
-            u[i] = 0.0
-            v[i] = 0.0
-        total += hits
-    return total

@@ -46,7 +46,7 @@ def nodata_polylines(valid: np.ndarray, dx: float, dy: float, openings=(),
         Cell size [m].
     openings : sequence of (2, 2) arrays
         Inflow sections [m, local]: a staircase run along one keeps its end vertices, so that
-        ``floodsph.boundaries.openings.cut_openings`` finds a collinear segment to cut.
+        ``floodsph.walls.openings.cut_openings`` finds a collinear segment to cut.
     tolerance : float
         Largest distance [cells] of a chord from the staircase (below sqrt(2)).
 
@@ -249,7 +249,7 @@ def walled_slivers(valid: np.ndarray, dx: float, dy: float,
     """
     from scipy import ndimage
 
-    from floodsph.sph.walls import segments_from_polylines
+    from floodsph.walls.geometry import segments_from_polylines
 
     ok = np.asarray(valid, dtype=bool)
     out = np.zeros_like(ok)
@@ -323,7 +323,7 @@ def settle_seeds(x: np.ndarray, y: np.ndarray, valid: np.ndarray, dx: float, dy:
 
 def _separated(x0, y0, x1, y1, seg: np.ndarray) -> np.ndarray:
     """True where the segment (x0, y0)-(x1, y1) meets any wall segment (closed intervals,
-    as ``floodsph.sph.walls.crosses``)."""
+    as ``floodsph.walls.geometry.crosses``)."""
     out = np.zeros(np.shape(x0), dtype=bool)
     if seg.shape[0] == 0:
         return out

@@ -1,6 +1,6 @@
 """Wall junctions: walls that cross or meet are cut there, so that they share a vertex.
 
-The mirror images of ``floodsph.sph.walls`` complete the kernel in a right-angled corner only
+The mirror images of ``floodsph.walls`` complete the kernel in a right-angled corner only
 where the two segments share an end point (the corner's point reflection,
 ``walls.corner_image``). Walls from different sources meet elsewhere: a levee drawn across
 the DEM border crosses the border's side segment, a wall may end on another (a T), and two
