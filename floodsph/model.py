@@ -68,10 +68,11 @@ class FloodModel:
         (``floodsph.boundaries.OpenEdges``). A collection of sides (``"west"``, ``"east"``,
         ``"south"``, ``"north"``) closes those sides and opens the others; nodata borders
         are then walls.
-    boundaries : sequence
-        Open boundaries (inflows, sinks): objects with ``apply(model, dt)`` called after each
-        drift; they add to ``volume_in`` / ``volume_out`` what they inject or remove, and
-        ``protected(x, y) -> bool array`` marking particles in their zone of influence.
+    boundaries : sequence of floodsph.boundaries.protocol.Boundary
+        Open boundaries (inflows, sinks), each keeping that contract: ``apply`` after each
+        drift (adding to ``volume_in`` / ``volume_out`` what they inject or remove),
+        ``add_ghosts`` and ``impose`` around the density solve, ``protected``, ``max_dt`` and
+        ``opening``.
     refiner : object or None
         Particle splitting and coalescing: ``apply(model) -> (splits, merges)``, called after
         the boundaries once the particles have moved (``floodsph.refinement``).
@@ -99,7 +100,7 @@ class FloodModel:
         if open_sides:
             self.boundaries.insert(0, OpenEdges(terrain.width, terrain.height, open_sides))
         h0 = numerics.kappa * numerics.particle_spacing_m
-        openings = [b.opening for b in self.boundaries if hasattr(b, "opening")]
+        openings = [b.opening for b in self.boundaries if b.opening is not None]
         self.seg = model_segments(terrain, walls, closed, closed_edges is not False, openings,
                                   h0, numerics.particle_spacing_m)
         self.wall_index = WallIndex(
@@ -149,8 +150,7 @@ class FloodModel:
         cfl = self.numerics.cfl
         dt = float(forces.stable_dt(p.u, p.v, p.rho, p.h, cfl)) if p.n else np.inf
         for boundary in self.boundaries:
-            if hasattr(boundary, "max_dt"):
-                dt = min(dt, boundary.max_dt(cfl))
+            dt = min(dt, boundary.max_dt(cfl))
         return dt
 
     # -- one step ------------------------------------------------------------------------------

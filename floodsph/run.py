@@ -404,6 +404,8 @@ def _save(sim, scenario, threads, manifest, mass, recorders, work, wall_start) -
 
 
 def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
+    from floodsph.boundaries import Inflow
+
     manifest["finished"] = now_iso()
     manifest["wall_time_s"] = wall_time
     if model is None:
@@ -420,7 +422,7 @@ def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
         volume_domain_m3=float(model.volume()),
         volume_in_m3=float(model.volume_in),
         volume_out_m3=float(model.volume_out),
-        inflows=[_inflow_summary(b) for b in model.boundaries if hasattr(b, "pending")],
+        inflows=[_inflow_summary(b) for b in model.boundaries if isinstance(b, Inflow)],
     )
     if mass is not None:
         manifest["mass_error_rel"] = mass.budget(model).error_rel

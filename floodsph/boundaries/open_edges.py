@@ -229,6 +229,13 @@ class OpenEdges:
         p.u[g] = b["u"]
         p.v[g] = b["v"]
 
+    opening = None
+    """No section: walls are not cut for this boundary (``Boundary.opening``)."""
+
+    def max_dt(self, cfl: float) -> float:
+        """No limit of its own on the step [s] (``Boundary.max_dt``)."""
+        return math.inf
+
     def protected(self, x, y) -> np.ndarray:
         """Particles within the buffer reach of an open side (no coalescing there)."""
         return (self._beyond(x, y) > -self.reach).any(axis=0)

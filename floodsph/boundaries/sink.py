@@ -65,6 +65,13 @@ class Sink:
     def impose(self, model) -> None:
         """A sink imposes no state."""
 
+    opening = None
+    """No section: walls are not cut for this boundary (``Boundary.opening``)."""
+
+    def max_dt(self, cfl: float) -> float:
+        """No limit of its own on the step [s] (``Boundary.max_dt``)."""
+        return math.inf
+
     def protected(self, x, y) -> np.ndarray:
         return self._lookup(self.near, x, y)
 
