@@ -73,7 +73,7 @@ def _setting(default, kind, *, gt=None, ge=None, le=None, optional=False, scenar
 
 SMOOTHING_EXCESS = 3.0
 """Default of ``Numerics.refine_smoothing_excess``: split particles relax to h = sqrt(3) kappa
-sqrt(m / rho), not to the lattice value: on the coarse Ritter case (tests/test_refine.py) and
+sqrt(m / rho), not to the lattice value: on the coarse Ritter case (tests/sph/test_refine.py) and
 the first 60 s of Malpasset this beat both no relaxation (L1 2.3 %, front 252 m behind; 128 s
 of wall time) and relaxation to the lattice value (L1 3.7 %; 77 s): L1 1.8 %, front 19 m,
 50 s. The Ritter convergence study is sensitive to it (``workflows/ritter_sensitivity.py``)."""

@@ -264,7 +264,7 @@ class Refiner:
         split at once) and |v_t - v_b| <= speed_jump sqrt(g d_b). There is no depth test
         (across a bore or a front the speeds differ too): with h below half of its
         neighbours', t's own summed depth is mostly its self term and its nearest neighbour's,
-        2.9 m in 1 m of water 0.24 m from a neighbour (``tests/test_refine.py``).
+        2.9 m in 1 m of water 0.24 m from a neighbour (``tests/sph/test_refine.py``).
         """
         from floodsph.sph import refine
         from floodsph.sph.neighbours import NeighbourList
@@ -338,7 +338,7 @@ def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE,
     that work is small, but at an edge shrinking h raises the particle's own term, which grows
     as 1 / h^2, and with it the depth and the pressure that push the edge forward: the thin
     front of a refined dam break ran at up to 28 m/s, 40 % above the bound 2 sqrt(g d0) of the
-    exact solution (``tests/test_refine.py``).
+    exact solution (``tests/sph/test_refine.py``).
     """
     target = excess * kappa * kappa * p.m
     c = p.h0 * p.h0 * p.rho0

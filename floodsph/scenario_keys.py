@@ -3,7 +3,7 @@
 The parser (``floodsph.scenario``) decides which keys are accepted and checks their values;
 this module says what they are for. ``docs/scenario-reference.md`` is generated from
 :data:`TABLES` by ``python workflows/scenario_reference.py``, and
-``tests/test_scenario_reference.py`` fails when a key the parser accepts has no
+``tests/scenario/test_scenario_reference.py`` fails when a key the parser accepts has no
 :class:`KeyDoc` here, when a key here is refused by the parser, or when the page is stale.
 
 Defaults are not repeated here: they are read from the dataclass that the parser fills

@@ -22,6 +22,12 @@ BASIN_COLS = 10
 RESERVOIR_VOLUME_M3 = BASIN_COLS * CELL * NY * CELL * 2.0
 CRS = "EPSG:32632"
 
+TESTS = Path(__file__).resolve().parent
+"""The tests' root: its helper modules (``sph_cases``, ``golden_cases``, ``ensemble_cases``,
+this one) are imported by the test modules in the folders below, which mirror the package."""
+if str(TESTS) not in sys.path:
+    sys.path.insert(0, str(TESTS))
+
 
 def write_geotiff(path: Path, z: np.ndarray, *, x0=X0, y0=Y0, cell=CELL, crs=CRS, nodata=-9999.0):
     """Write a north-up float32 GeoTIFF whose lower-left corner is (x0, y0)."""

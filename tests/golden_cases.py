@@ -33,7 +33,7 @@ def _analytic(name: str, dx: float, **options) -> dict:
 
 def _scenario_run(tmp: Path) -> dict:
     """The dam break with an inflow, open edges, refinement and local steps of
-    ``tests/test_checkpoint_resume.py``, through ``run_scenario``."""
+    ``tests/run/test_checkpoint_resume.py``, through ``run_scenario``."""
     import csv
 
     import rasterio

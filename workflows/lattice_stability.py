@@ -18,7 +18,7 @@ still or starts to stir itself after a few minutes.
    walls), particles at 20 m with positions perturbed by 2 cm (0.1 % of the spacing, random),
    run with ``FloodModel``; the maximum particle speed is printed every 80 s.
 3. **A lake with a shore** (``--bowl-end-time``): the parabolic bowl of
-   ``tests/test_sph_dynamics.py``, b = 10 ((x - 500)^2 + (y - 500)^2) / 500^2 m, filled to
+   ``tests/sph/test_sph_dynamics.py``, b = 10 ((x - 500)^2 + (y - 500)^2) / 500^2 m, filled to
    the level 5 m (the shore on a 2.8 % slope at r = 354 m), 10 m particles, frictionless;
    the maximum and 95th-percentile speeds and the largest level error are printed every
    ``--bowl-every`` s.

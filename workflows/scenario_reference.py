@@ -2,7 +2,7 @@
 
 The page is made from ``floodsph.scenario_keys.TABLES`` (type, units and meaning of each key)
 and the defaults of the dataclasses the parser fills, so it shows what the code accepts.
-Re-run it after adding or changing a key; ``tests/test_scenario_reference.py`` fails while
+Re-run it after adding or changing a key; ``tests/scenario/test_scenario_reference.py`` fails while
 the committed page differs from what this script writes.
 
 Usage: ``python workflows/scenario_reference.py [--out FILE]``

@@ -4,7 +4,7 @@ set-up of ``floodsph.walls.seeding`` (seeds settled, masses matched to the seede
 Cases (flat, frictionless beds; walls as ``FloodModel(walls=...)`` polylines):
 
 * ``turned-rectangle``: 2 m of water inside a 300 m x 180 m rectangle of walls turned by
-  30 degrees, 5 m spacing (the lake of ``tests/test_wall_seeding.py``);
+  30 degrees, 5 m spacing (the lake of ``tests/walls/test_wall_seeding.py``);
 * ``turned-building``: 3 m of water around a 200 m square footprint turned by 30 degrees,
   10 m spacing (four convex corners);
 * ``large-building``: the same footprint in a 2 km x 1.5 km lake at 5 m spacing (118,400

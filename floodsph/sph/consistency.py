@@ -25,7 +25,7 @@ linear momentum is conserved exactly:
 Only M's shape is corrected, not its size (M / sqrt(det M) has det 1): where h varies over an
 undistorted lattice (a lake over a bump) M_i = c I with c != 1, and the variational force's
 other part, d_i E_i, already balances it; correcting c as well stirred the lake over the
-Gaussian bump of ``tests/test_sph_dynamics.py`` to 0.015 m/s in 200 s (0.004 m/s without
+Gaussian bump of ``tests/sph/test_sph_dynamics.py`` to 0.015 m/s in 200 s (0.004 m/s without
 any renormalisation, 0.008 m/s with this one).
 
 K_i = 0 where i's own kernel support is cut, |e_i| h_i >= ``EDGE`` with
@@ -33,7 +33,7 @@ e_i = - sum_j (m_j/rho_j) F(r_ij, h_i) r_ij (0 in a full support, of order 1/h a
 fronts and shores), and where M_i is near singular (det M_i < ``DET_MIN``). On a bed that is
 not flat, K_i = 0 also where the shore balance may act (|E_i| h_i / g >=
 ``floodsph.sph.shore.FULL_SUPPORT``, E_i the pair sum of that module): renormalised there,
-the shore of the parabolic bowl of ``tests/test_shore.py`` moved at 0.28 m/s after 200 s
+the shore of the parabolic bowl of ``tests/sph/test_shore.py`` moved at 0.28 m/s after 200 s
 (0.08 m/s without). E_i alone cannot tell edges: h's own gradient makes it as large in a
 stretched rarefaction as at a front. With ``EDGE`` = 0.1, between the median 0.0005 of
 Ritter's rarefaction at 600-740 m and the 0.09 of its 60 front-most particles (10 m), the

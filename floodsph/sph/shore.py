@@ -13,7 +13,7 @@ bed that push is what drives a wet/dry front (Ritter's dam break). At the shore 
 is wrong: the water ends because the bed rises through its surface, the true depth falls to
 zero, and the push together with the cut-down D_i cannot balance the bed's pull -g grad b, so
 the shore slid down the slope (0.27 m s-2 on the 2.8 % bowl of
-``tests/test_sph_dynamics.py``).
+``tests/sph/test_sph_dynamics.py``).
 
 The push is therefore limited by the hydrostatic reconstruction of Audusse, Bouchut, Bristeau,
 Klein & Perthame (SIAM J. Sci. Comput. 25 (2004) 2050-2065) across the edge: the water at i

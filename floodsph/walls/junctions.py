@@ -6,7 +6,7 @@ where the two segments share an end point (the corner's point reflection,
 the DEM border crosses the border's side segment, a wall may end on another (a T), and two
 user walls may cross (an X). Without a shared vertex such a corner gets single images only,
 and still water in it reads up to 6 % too shallow and starts to move (0.28 m/s within 5 s in
-right-angled crossings of 5 m particles, 2 m deep: tests/test_sph_dynamics.py).
+right-angled crossings of 5 m particles, 2 m deep: tests/sph/test_sph_dynamics.py).
 
 :func:`split_at_junctions` cuts every segment at the points where another segment crosses its
 interior or ends on it, at exactly the same coordinates for both, so that every junction is

@@ -7,7 +7,7 @@ images (``floodsph.walls``) complete the support exactly only where the lattice 
 along the wall, half a spacing from it. Along an oblique wall (a nodata chord, a user's
 embankment) the seeds lie at every distance from it, and their images crowd them or leave
 gaps. In a frictionless 2 m lake held by a rectangle of walls turned by 30 degrees (5 m
-spacing, ``tests/test_wall_seeding.py``) the seeds next to the walls read up to 0.84 m off,
+spacing, ``tests/walls/test_wall_seeding.py``) the seeds next to the walls read up to 0.84 m off,
 and the lake sloshed: 95th-percentile speed 0.074 / 0.037 / 0.032 m/s after 20 / 100 / 200 s,
 0.048 m/s at most after 200 s. A wall along the rows does the same where it is not half a
 spacing from the last row: in Ritter's 100 m wide channel at a spacing of 10 / sqrt(7) m the
@@ -35,7 +35,7 @@ after 200 s; the Ritter run above has an L1 error of 0.66 %. In the lake, settli
 0.022 / 0.012 / 0.014 m/s (depth within 2 %); 100 rounds 0.019 / 0.009 / 0.009, 1,000 rounds
 0.017 / 0.007 / 0.006. Matching alone (masses within 0.8-1.25 times) gave
 0.032 / 0.020 / 0.020 m/s. Unbounded, it took some masses to 1.7 times their seed, and in the
-nodata basin of ``tests/test_nodata_walls.py`` such a particle, squeezed into a corner,
+nodata basin of ``tests/walls/test_nodata_walls.py`` such a particle, squeezed into a corner,
 reached 12.8 m/s; after settling, the masses of the lake above stay within 0.95-1.08 times.
 
 Which seeds: lattice seeds (m = rho_w d* dx^2: not inflow or split particles) with a wall in

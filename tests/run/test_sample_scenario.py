@@ -20,7 +20,7 @@ from click.testing import CliRunner
 
 from floodsph.cli.main import cli
 
-SAMPLE = Path(__file__).resolve().parents[1] / "data_samples" / "valley"
+SAMPLE = Path(__file__).resolve().parents[2] / "data_samples" / "valley"
 SCENARIO = SAMPLE / "scenario.toml"
 DEM = SAMPLE / "dem.tif"
 MAX_STEPS = 20

@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 from conftest import BASE_SCENARIO, CELL, NX, NY, X0, Y0, load_workflow, write_geotiff
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 WORKFLOWS = REPO / "workflows"
 
 

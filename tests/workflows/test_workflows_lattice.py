@@ -11,7 +11,7 @@ from conftest import load_workflow
 from floodsph.numerics import Numerics
 
 lattice = load_workflow("lattice_stability",
-                        Path(__file__).resolve().parents[1] / "workflows" / "lattice_stability.py")
+                        Path(__file__).resolve().parents[2] / "workflows" / "lattice_stability.py")
 
 
 def test_the_seeding_lattice_is_a_minimum_of_the_sph_energy_at_the_default_kappa_only():

@@ -13,7 +13,7 @@ from floodsph.numerics import Numerics
 from floodsph.refinement import Refiner
 from floodsph.sph import neighbours
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 prof = load_workflow("profile_stages", REPO / "workflows" / "profile_stages.py")
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from conftest import load_workflow
 from ensemble_cases import ensemble_text, write_case
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 convergence = load_workflow("ensemble_convergence",
                             REPO / "workflows" / "ensemble_convergence.py")
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from conftest import load_workflow
 
-WORKFLOWS = Path(__file__).resolve().parents[1] / "workflows"
+WORKFLOWS = Path(__file__).resolve().parents[2] / "workflows"
 cases = load_workflow("still_water_cases", WORKFLOWS / "still_water_cases.py")
 still = load_workflow("still_water", WORKFLOWS / "still_water.py")
 

@@ -18,7 +18,7 @@ from floodsph.errors import InputError
 from floodsph.scenario import scenario_from_dict
 from floodsph.scenario_keys import TABLES
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "scenario-reference.md"
 generator = load_workflow("scenario_reference", ROOT / "workflows" / "scenario_reference.py")
 UNKNOWN = "zz_no_such_key"

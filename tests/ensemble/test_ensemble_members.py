@@ -111,7 +111,7 @@ def test_the_sample_ensemble_builds_its_members(tmp_path):
 
     from floodsph.breach.formulas import froehlich2008_average_width
 
-    sample = Path(__file__).resolve().parents[1] / "data_samples" / "valley_breach"
+    sample = Path(__file__).resolve().parents[2] / "data_samples" / "valley_breach"
     members, samples = members_of(sample / "ensemble.toml", tmp_path)
     assert len(members) == 32
     width = froehlich2008_average_width(2.3e6, 9.0, "overtopping")

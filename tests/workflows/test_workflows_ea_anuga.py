@@ -23,7 +23,7 @@ import pytest
 from click.testing import CliRunner
 from conftest import BASE_SCENARIO, X0, Y0, load_workflow, write_geotiff
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 vgc = load_workflow("workflow_versus_grid_code", REPO / "workflows" / "versus_grid_code.py")

@@ -15,7 +15,7 @@ from conftest import CELL, CRS, NX, NY, RESERVOIR_VOLUME_M3, X0, Y0
 
 import floodsph
 
-DOCS = Path(__file__).parents[1] / "docs" / "api.md"
+DOCS = Path(__file__).parents[2] / "docs" / "api.md"
 
 
 def python_block(page: Path) -> str:

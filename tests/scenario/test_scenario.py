@@ -261,7 +261,7 @@ def test_worldcover_manning_table_from_toml(write_scenario, tmp_path):
         "manning = 0.03", 'landcover = "landcover.tif"\nmanning_table = "worldcover"')
     sc = load_scenario(write_scenario(text))
     assert sc.terrain.manning_table == "worldcover" and sc.terrain.manning is None
-    table_file = Path(__file__).parents[1] / "floodsph" / "data" / "worldcover_manning.csv"
+    table_file = Path(__file__).parents[2] / "floodsph" / "data" / "worldcover_manning.csv"
     with open(table_file, encoding="utf-8") as f:
         documented = {row["name"]: float(row["manning_n"]) for row in csv.DictReader(f)}
     n = prepare_inputs(sc).terrain.manning

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from conftest import load_workflow
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 WORKFLOWS = REPO / "workflows"
 
 

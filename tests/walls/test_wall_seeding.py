@@ -16,7 +16,7 @@ from floodsph.walls.geometry import segments_from_polylines
 from floodsph.walls.index import WallIndex
 
 STILL = load_workflow("still_water_at_walls",
-                      Path(__file__).parents[1] / "workflows" / "still_water_at_walls.py")
+                      Path(__file__).parents[2] / "workflows" / "still_water_at_walls.py")
 
 
 @pytest.fixture(scope="module")

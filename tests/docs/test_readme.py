@@ -12,7 +12,7 @@ import click
 
 from floodsph.cli.main import cli
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 MAX_LINES = 200
 

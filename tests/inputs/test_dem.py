@@ -218,7 +218,7 @@ def test_extent_crop_to_whole_cells(tmp_path):
 def benchmarks_dir() -> Path:
     env = os.environ.get("FLOODSPH_BENCHMARKS")
     return (
-        Path(env) if env else Path(__file__).resolve().parents[1] / ".." / "shared" / "benchmarks"
+        Path(env) if env else Path(__file__).resolve().parents[2] / ".." / "shared" / "benchmarks"
     )
 
 
