@@ -250,6 +250,12 @@ class FloodModel:
         self.counters["particles_max"] = max(self.counters["particles_max"], p.n)
         self.counters["particle_updates"] += p.n if updated is None else updated
 
+    def particles_changed(self) -> None:
+        """Say that particles were added or removed outside the step (a refinement, a
+        boundary): the neighbour and near-wall lists are stale, and the next step rebuilds
+        them."""
+        self.nl = None
+
     def protected(self, x, y, h) -> np.ndarray:
         """True for points (x, y) [m] with a wall segment within the kernel reach of h [m]
         (with the neighbour lists' skin), or in an open boundary's zone: no merging there."""

@@ -154,7 +154,7 @@ class Refiner:
         for fields in (born, merged):
             if fields is not None:
                 p.append(**fields)
-        model.nl = None  # the particles changed: the neighbour and near-wall lists are stale
+        model.particles_changed()
         return int(parents.size), int(a.size)
 
     # -- splitting ---------------------------------------------------------------------------

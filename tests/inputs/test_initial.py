@@ -176,3 +176,19 @@ def test_thin_shore_cells_give_their_water_to_the_deepest_neighbour():
     np.testing.assert_array_equal(lump_thin_cells(sheet), sheet)
     gentle = np.outer(np.ones(4), [0.5, 1.0, 1.5, 2.0])
     np.testing.assert_array_equal(lump_thin_cells(gentle), gentle)
+
+
+def test_a_nodata_sliver_belongs_to_the_water_of_its_nearest_valid_cell():
+    """Two basins (bed 0) split by a nodata strip two cells wide (columns 10-11). A level of
+    5 m over a polygon that covers the west basin and the strip fills the west basin and the
+    strip cell next to it, whose nearest valid cell is in the basin. The strip cell next to
+    the east basin takes the east basin's bed, and the east basin is outside the polygon: it
+    stays dry, else its water would be water nobody put in the east basin."""
+    ter = Terrain.from_function(lambda x, y: 0.0 * x, (0.0, 240.0), (0.0, 100.0), CELL)
+    ter.valid[:, 10:12] = False
+    wet = ter.valid.copy()
+    wet[:, 10:12] = True  # both strip cells may hold water (slivers inside walls)
+    polygon = [[0.0, 0.0], [118.0, 0.0], [118.0, 100.0], [0.0, 100.0], [0.0, 0.0]]
+    d = depth_from_level(ter, 5.0, polygon, wet=wet)
+    assert np.all(d[:, :11] == 5.0)
+    assert np.all(d[:, 11:] == 0.0)
