@@ -262,12 +262,26 @@ def seed_particles(
     depth = d[li, ki]
     if particles is None:
         particles = ParticleSet(capacity=max(2 * depth.size, 1024))
-    if depth.size:
-        particles.append(
-            x=xs[ki],
-            y=ys[li],
-            m=RHO_WATER * depth * dx**2,
-            rho=RHO_WATER * depth,
-            h=np.full(depth.size, kappa * dx),
-        )
+    return particles_at(xs[ki], ys[li], depth, dx, kappa, particles=particles)
+
+
+def particles_at(x, y, d, dx: float, kappa: float, u=0.0, v=0.0, d_min: float = 0.0,
+                 particles: ParticleSet | None = None) -> ParticleSet:
+    """Water particles at the lattice nodes (x, y) [m, local] of spacing dx [m] where the depth
+    d [m] exceeds ``d_min``: the one seeding convention of runs, verification cases and tests.
+
+    Each particle is the water column of its lattice cell: m = rho_w d dx^2 [kg],
+    rho = rho_w d [kg m-2], h = kappa dx [m], velocity (u, v) [m s-1] (scalars or arrays like
+    x). Appended to ``particles`` if given, else to a new set.
+    """
+    x, y, d = (np.asarray(a, dtype=np.float64) for a in (x, y, d))
+    keep = d > d_min
+    count = int(keep.sum())
+    if particles is None:
+        particles = ParticleSet(count)
+    if count:
+        particles.append(x=x[keep], y=y[keep], m=RHO_WATER * d[keep] * dx**2,
+                         rho=RHO_WATER * d[keep], h=np.full(count, kappa * dx),
+                         u=np.broadcast_to(u, x.shape)[keep],
+                         v=np.broadcast_to(v, x.shape)[keep])
     return particles

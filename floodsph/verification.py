@@ -24,11 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from floodsph import testing as exact
-from floodsph.constants import RHO_WATER
+from floodsph.initial import particles_at
 from floodsph.model import FloodModel
 from floodsph.numerics import Numerics, Refinement
 from floodsph.output.rasterise import interpolate
-from floodsph.particles import ParticleSet
 from floodsph.terrain import Terrain
 
 
@@ -68,15 +67,9 @@ def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **nume
     terrain = Terrain.from_function(bed, xlim, ylim, cell)
     X, Y = np.meshgrid(np.arange(dx / 2, terrain.width, dx), np.arange(dx / 2, terrain.height, dx))
     x, y = X.ravel(), Y.ravel()
-    d = depth(x + terrain.x0, y + terrain.y0)
-    wet = d > 1e-3
-    p = ParticleSet(int(wet.sum()))
-    p.append(x=x[wet], y=y[wet], m=RHO_WATER * d[wet] * dx * dx, rho=RHO_WATER * d[wet],
-             h=np.full(int(wet.sum()), kappa * dx),
-             u=np.broadcast_to(u(x + terrain.x0, y + terrain.y0), x.shape)[wet] if callable(u)
-             else u,
-             v=np.broadcast_to(v(x + terrain.x0, y + terrain.y0), x.shape)[wet] if callable(v)
-             else v)
+    xw, yw = x + terrain.x0, y + terrain.y0
+    p = particles_at(x, y, depth(xw, yw), dx, kappa, u=u(xw, yw) if callable(u) else u,
+                     v=v(xw, yw) if callable(v) else v, d_min=1e-3)
     num = Numerics(particle_spacing_m=dx, kappa=kappa,
                    **{"refinement": Refinement.NONE, **numerics})
     return FloodModel(terrain, p, num, refiner=Refiner.of(num))

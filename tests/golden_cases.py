@@ -38,7 +38,7 @@ def _scenario_run(tmp: Path) -> dict:
 
     import rasterio
     from conftest import valley_elevation, write_geotiff
-    from test_checkpoint_resume import write_dam_break
+    from run_cases import write_dam_break
 
     from floodsph.run import run_scenario
     from floodsph.scenario import load_scenario

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from floodsph.constants import RHO_WATER
+from floodsph.initial import particles_at
 from floodsph.model import FloodModel
 from floodsph.numerics import Numerics
 from floodsph.particles import ParticleSet
@@ -18,13 +18,8 @@ def lattice(x0, x1, y0, y1, dx):
 
 
 def particles_with_depth(x, y, d, dx, kappa, u=0.0, v=0.0) -> ParticleSet:
-    """Particles of volume d dx^2 at (x, y), with the seeding convention of floodsph.initial."""
-    keep = d > 0
-    p = ParticleSet(int(keep.sum()))
-    p.append(x=x[keep], y=y[keep], m=RHO_WATER * d[keep] * dx * dx, rho=RHO_WATER * d[keep],
-             h=np.full(int(keep.sum()), kappa * dx),
-             u=np.broadcast_to(u, x.shape)[keep], v=np.broadcast_to(v, x.shape)[keep])
-    return p
+    """Particles of volume d dx^2 at (x, y) where d > 0 (``floodsph.initial.particles_at``)."""
+    return particles_at(x, y, d, dx, kappa, u=u, v=v)
 
 
 def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, manning=0.0,

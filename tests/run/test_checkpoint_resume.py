@@ -18,48 +18,12 @@ import numpy as np
 import pytest
 import rasterio
 import xarray as xr
-from conftest import CELL, NY, X0, Y0
+from run_cases import write_dam_break
 
 from floodsph.output.envelopes import MAPS
 from floodsph.run import run_scenario
 from floodsph.scenario import load_scenario
 from floodsph.schedules import IterationInterval
-
-DAM_BREAK = f"""
-[scenario]
-name = "resume"
-end_time_s = 40.0
-
-[terrain]
-dem = "dem.tif"
-manning = 0.03
-edges = "open"
-
-[[initial_water]]
-level_m = 101.0
-polygon = [[{X0}, {Y0}], [{X0 + 100}, {Y0}], [{X0 + 100}, {Y0 + NY * CELL}],
-           [{X0}, {Y0 + NY * CELL}]]
-
-[[inflows]]
-line = [[{X0 + 150}, {Y0 + 50}], [{X0 + 150}, {Y0 + 150}]]
-hydrograph = "q.csv"
-direction = [1.0, 0.0]
-
-[gauges]
-file = "gauges.csv"
-interval_s = 2.0
-
-[numerics]
-particle_spacing_m = 10.0
-refinement = "split+coalesce"
-time_stepping = "{{stepping}}"
-
-[output]
-resolution_m = 10.0
-mass_balance_interval_s = 2.0
-checkpoint_interval_s = 10.0
-snapshot_interval_s = 5.0
-"""
 
 
 def sigterm_at(step: int | None):
@@ -72,19 +36,6 @@ def sigterm_at(step: int | None):
             os.kill(os.getpid(), signal.SIGTERM)
 
     return callback, IterationInterval(1)
-
-
-def write_dam_break(folder, stepping: str = "global", end_time: float = 40.0):
-    """The scenario file of :data:`DAM_BREAK` with its hydrograph and gauges, beside the
-    valley DEM in ``folder``."""
-    (folder / "q.csv").write_text("time_s,discharge_m3s\n0,0\n10,20\n30,20\n40,0\n")
-    (folder / "gauges.csv").write_text(
-        f"id,x,y\nbasin,{X0 + 50},{Y0 + 100}\nfloor,{X0 + 250},{Y0 + 100}\n")
-    text = DAM_BREAK.replace("{stepping}", stepping).replace(
-        "end_time_s = 40.0", f"end_time_s = {end_time}")
-    path = folder / f"{stepping}-{end_time:g}.toml"
-    path.write_text(text, encoding="utf-8")
-    return path
 
 
 @pytest.fixture
