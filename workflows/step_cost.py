@@ -72,11 +72,10 @@ def measure(spacing: float, steps: int, warmup: int) -> dict:
     model = dam_break(spacing)
     for _ in range(warmup):
         model.step()
-    try:
+    timer = None
+    if hasattr(model, "stage_timer"):  # else a checkout from before the stage timer
         from floodsph.stage_timer import StageTimer
-    except ImportError:
-        timer = None
-    else:
+
         timer = model.stage_timer = StageTimer()
     updates = model.counters["particle_updates"]
     t0 = time.perf_counter()
@@ -94,8 +93,13 @@ def measure(spacing: float, steps: int, warmup: int) -> dict:
 def worker() -> int:
     """Serve measurements: one JSON request (spacing, steps, warmup) per stdin line, one JSON
     result per stdout line."""
+    import floodsph
     from floodsph.run import set_threads
 
+    root = Path(os.environ["PYTHONPATH"]).resolve()
+    if not Path(floodsph.__file__).resolve().is_relative_to(root):
+        raise SystemExit(f"step_cost worker: floodsph imported from {floodsph.__file__}, "
+                         f"not from {root}")
     set_threads(int(os.environ.get("STEP_COST_THREADS", "1")))
     for line in sys.stdin:
         request = json.loads(line)
