@@ -76,7 +76,15 @@ class FloodModel:
     refiner : object or None
         Particle splitting and coalescing: ``apply(model) -> (splits, merges)``, called after
         the boundaries once the particles have moved (``floodsph.refinement``).
+
+    Attributes
+    ----------
+    stage_timer : StageTimer or None
+        Set it to a ``floodsph.stage_timer.StageTimer`` to have every step add the wall time
+        of each of its stages there (None, the default: no timing).
     """
+
+    stage_timer = None  # a class default, so that models pickled before it existed load
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
                  walls=(), closed_edges: bool = True, boundaries=(), refiner=None):
@@ -112,7 +120,7 @@ class FloodModel:
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
                          "wall_reflections": 0, "density_unconverged": 0,
                          "density_capped": 0, "density_held": 0, "particle_updates": 0,
-                         "seeds_settled": 0, "settle_steps": 0}
+                         "seeds_settled": 0, "settle_steps": 0, "neighbour_builds": 0}
         self.bed = np.empty((0, 7))
         self.pair_sums = np.empty((0, forces.SUMS))
         self.shores = bool(np.ptp(terrain.elevation) > 0.0)  # a flat bed has no shore to balance
@@ -122,6 +130,7 @@ class FloodModel:
         self.walled = np.zeros(0, dtype=np.bool_)
         self._blocked_nl = None
         self._nl_fresh = False  # lists built in this step
+        self._nl_here = False  # lists built at the current positions
         for boundary in self.boundaries:
             boundary.apply(self, 0.0)
         self._settle_seeds()
@@ -147,10 +156,13 @@ class FloodModel:
     def stable_dt(self) -> float:
         """dt = cfl min h / (|v| + c) over the water and the open boundaries' buffers [s]."""
         p = self.particles
-        cfl = self.numerics.cfl
-        dt = float(forces.stable_dt(p.u, p.v, p.rho, p.h, cfl)) if p.n else np.inf
+        dt = float(forces.stable_dt(p.u, p.v, p.rho, p.h, self.numerics.cfl)) if p.n else np.inf
+        return self._boundaries_dt(dt)
+
+    def _boundaries_dt(self, dt: float) -> float:
+        """The water's CFL step dt [s], shortened to what the open boundaries allow."""
         for boundary in self.boundaries:
-            dt = min(dt, boundary.max_dt(cfl))
+            dt = min(dt, boundary.max_dt(self.numerics.cfl))
         return dt
 
     # -- one step ------------------------------------------------------------------------------
@@ -160,25 +172,32 @@ class FloodModel:
         With local time stepping the step is a big step of up to 2^K finest steps
         (:meth:`_step_local`), at the end of which every particle is synchronised.
         """
+        timer = self.stage_timer
+        if timer is not None:
+            timer.begin()
         self._nl_fresh = False
+        self._nl_here = False
         if getattr(self, "nl", None) is None:  # particles were added or removed between steps
             self._neighbours()
         if self.numerics.time_stepping is TimeStepping.LOCAL:
-            return self._step_local(dt_max)
+            dt = self._step_local(dt_max)
+            if timer is not None:
+                timer.end()
+            return dt
         p = self.particles
         dt = self.dt if dt_max is None else min(self.dt, dt_max)
         half = 0.5 * dt
-        p.u[:] += half * p.ax
-        p.v[:] += half * p.ay
+        forces.kick(p.u, p.v, p.ax, p.ay, half)
         self._move(dt)
         self._synchronise()
         self._interactions()
-        p.u[:] += half * p.ax
-        p.v[:] += half * p.ay
-        forces.apply_friction(p.u, p.v, p.rho, self.bed[: p.n, 6], dt,
-                              self.numerics.friction_depth_floor_m)
+        num = self.numerics
+        dt_water = forces.close_step(p.u, p.v, p.ax, p.ay, half, p.rho, p.h, self.bed[: p.n, 6],
+                                     dt, num.friction_depth_floor_m, num.cfl)
         self._advance_clock(dt)
-        self.dt = self.stable_dt()
+        self.dt = self._boundaries_dt(float(dt_water))
+        if timer is not None:
+            timer.end()
         return dt
 
     def _step_local(self, dt_max: float | None) -> float:
@@ -226,10 +245,14 @@ class FloodModel:
         p = self.particles
         self.counters["wall_reflections"] += int(sight.drift(
             p.x, p.y, p.u, p.v, dt, *self.walls_near[:2], self.seg))
+        self._nl_here = False
+        self._lap("kick_drift")
         for boundary in self.boundaries:
             boundary.apply(self, dt)
         self._remove_outside(nodata=self.closed_edges is False)
+        self._lap("boundaries")
         density.predict(p.rho, p.h, p.divv, dt)
+        self._lap("density")
 
     def _synchronise(self, steps_taken: int = 1) -> None:
         """Refinement, and the periodic re-sort, on synchronised particles; ``steps_taken``
@@ -241,6 +264,12 @@ class FloodModel:
         every = self.numerics.reorder_interval
         if every and self.steps // every != (self.steps - steps_taken) // every:
             self._reorder()
+        self._lap("refinement")
+
+    def _lap(self, stage: str) -> None:
+        """Mark the end of a stage of the step for the stage timer, if one is set."""
+        if self.stage_timer is not None:
+            self.stage_timer.lap(stage)
 
     def _advance_clock(self, dt: float, updated: int | None = None) -> None:
         """t += dt, one more finest step, and the counters of particles and updates."""
@@ -281,15 +310,19 @@ class FloodModel:
         water = p.mark()
         for boundary in self.boundaries:
             boundary.add_ghosts(self)
+        self._lap("boundaries")
         if rows is None:
             self._neighbours()
         else:
             ghosts = np.arange(water[0], p.n, dtype=np.int64)
             self._neighbours(force=True, rows=np.concatenate([rows, ghosts]))
         self._solve_density(settle)
+        self._lap("density")
         for boundary in self.boundaries:
             boundary.impose(self)
+        self._lap("boundaries")
         self._forces()
+        self._lap("forces")
         p.truncate(water)
 
     def _settle_seeds(self) -> None:
@@ -422,13 +455,17 @@ class FloodModel:
         p = self.particles
         nl = getattr(self, "nl", None)
         if not force and nl is not None and nl.still_valid(p.x, p.y, p.h):
+            self._lap("neighbours")
             return
         self._nl_fresh = True
+        self.counters["neighbour_builds"] += 1
+        self._nl_here = True  # built at the current positions (until the next drift)
         h_search = p.h * np.clip(p.hgrow, 1.0, MAX_SEARCH_GROWTH)
         self.nl = NeighbourList(p.x, p.y, h_search, skin=self.numerics.neighbour_skin,
                                 rows=rows)
         self.walls_near = self.wall_index.near_lists(p.x, p.y, h_search, self.nl.start,
                                                      self.nl.nbr, self.nl.reach)
+        self._lap("neighbours")
 
     def _blocked_pairs(self) -> None:
         """Flag the listed pairs that a wall separates, and measure the distances to the near
@@ -473,14 +510,18 @@ class FloodModel:
             outcome = density.solve_density(
                 p, self.nl, self.blocked, wdist, walls, self.seg,
                 tol=num.density_tol, max_iter=num.density_max_iter, h_ratio=num.h_ratio,
-                cap=not settle, integral=self.integral_walls)
+                cap=not settle, integral=self.integral_walls, unmoved=self._nl_here)
             if settle and self.nl.covers(p.x, p.y, p.h):
                 break
             if not settle and (outcome.capped == 0 or self._nl_fresh):
                 break
+            self._lap("density")
             self._neighbours(force=True, rows=None if self.nl.complete else self.nl.rows)
         rows = self.nl.rows
-        p.hgrow[rows] = p.h[rows] / h_predicted[rows]
+        if self.nl.complete:
+            p.hgrow[:] = p.h / h_predicted
+        else:
+            p.hgrow[rows] = p.h[rows] / h_predicted[rows]
         self.counters["density_unconverged"] += outcome.unconverged
         self.counters["density_capped"] += outcome.capped
         self.counters["density_held"] += outcome.held

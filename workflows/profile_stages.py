@@ -1,10 +1,10 @@
 """Where a run's time goes: wall time per stage of the time step, and list builds per step.
 
 Runs a scenario (the model of ``floodsph run``, without its outputs) for ``--steps`` steps or
-up to ``--end-time`` and times the stages of ``floodsph.model.FloodModel.step``: neighbour
-and near-wall lists (``_neighbours``), wall-blocked pairs, the density solve, the forces,
-the spatial re-sort, and refinement (the refiner's ``apply``). Times are exclusive.
-The rest of the step (drift, boundaries, friction, time step) is ``other``. Prints a markdown
+up to ``--end-time`` and times the stages of ``floodsph.model.FloodModel.step`` with the
+model's stage timer (``floodsph.stage_timer``: kick and drift, boundaries, refinement,
+neighbour lists, density, forces, closing kick). Times are exclusive; the time outside the
+steps is ``other``. Prints a markdown
 table and the neighbour-list builds per step. The first steps compile the numba kernels when
 they are not cached yet: ``--warmup`` steps (default 3) run before the clock starts.
 
@@ -27,54 +27,24 @@ from pathlib import Path
 
 from floodsph.output.tables import markdown
 
-STAGES = ("_neighbours", "_blocked_pairs", "_solve_density", "_forces", "_reorder")
-
-
-def timed(counter: Counter, stack: list, key: str, fn):
-    """``fn`` wrapped so that its exclusive wall time accumulates in ``counter[key]``: time
-    spent in another wrapped stage called from inside it (``stack``) counts there only."""
-    def wrapper(*args, **kwargs):
-        stack.append(key)
-        t0 = time.perf_counter()
-        try:
-            return fn(*args, **kwargs)
-        finally:
-            elapsed = time.perf_counter() - t0
-            stack.pop()
-            counter[key] += elapsed
-            if stack:
-                counter[stack[-1]] -= elapsed
-    return wrapper
-
 
 def profile(model, steps: int | None = None, end_time: float | None = None,
             warmup: int = 3) -> tuple[list[dict], dict]:
     """Step ``model`` and time its stages; returns (rows, totals).
 
-    ``rows`` has one dict per stage (``stage``, ``seconds``, ``percent``); ``totals`` the
-    wall time, steps, particle-steps and neighbour-list builds of the timed steps. Stage
-    methods are wrapped on this model instance only; a stage called from inside another
-    (lists built by the refiner) counts in both, so refinement includes its list builds.
+    ``rows`` has one dict per stage of ``floodsph.stage_timer`` (``stage``, ``seconds``,
+    ``percent``), most costly first, and ``other`` for the time outside the steps; ``totals``
+    the wall time, steps, particle-steps and neighbour-list builds per step (the model's
+    ``neighbour_builds`` counter) of the timed steps. The timer is the model's public hook
+    (``FloodModel.stage_timer``), removed again afterwards.
     """
-    from floodsph.sph import neighbours
+    from floodsph.stage_timer import StageTimer
 
     for _ in range(warmup):
         model.step()
-    times: Counter = Counter()
-    stack: list = []
-    for name in STAGES:
-        setattr(model, name, timed(times, stack, name.strip("_"), getattr(model, name)))
-    if model.refiner is not None:
-        model.refiner.apply = timed(times, stack, "refinement", model.refiner.apply)
-    builds = Counter()
-    build = neighbours.NeighbourList.__init__
-
-    def counting_build(self, *args, **kwargs):
-        builds["lists"] += 1
-        build(self, *args, **kwargs)
-
-    neighbours.NeighbourList.__init__ = counting_build
-    step0, particle_steps = model.steps, 0
+    timer = StageTimer()
+    model.stage_timer = timer
+    step0, builds0, particle_steps = model.steps, model.counters["neighbour_builds"], 0
     t0 = time.perf_counter()
     try:
         while (steps is None or model.steps - step0 < steps) and (
@@ -82,15 +52,17 @@ def profile(model, steps: int | None = None, end_time: float | None = None,
             model.step()
             particle_steps += model.particles.n
     finally:
-        neighbours.NeighbourList.__init__ = build
+        model.stage_timer = None
     wall = time.perf_counter() - t0
     nsteps = model.steps - step0
-    times["other"] = wall - sum(times.values())
+    times = Counter(timer.seconds)
+    times["other"] = wall - sum(timer.seconds.values())
     rows = [{"stage": k, "seconds": v, "percent": 100.0 * v / wall}
             for k, v in times.most_common()]
     totals = {"wall_s": wall, "steps": nsteps, "sim_time_s": model.t,
               "particle_steps": particle_steps,
-              "list_builds_per_step": builds["lists"] / max(nsteps, 1)}
+              "list_builds_per_step": (model.counters["neighbour_builds"] - builds0)
+              / max(nsteps, 1)}
     return rows, totals
 
 

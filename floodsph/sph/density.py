@@ -227,7 +227,7 @@ def predict(rho, h, divv, dt):
 
 
 def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0,
-                  cap=False, integral=False):
+                  cap=False, integral=False, unmoved=False):
     """Solve (1)-(3) in place for the particles of ``p`` that ``nl`` lists (``nl.rows``).
 
     ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList;
@@ -237,20 +237,35 @@ def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ra
     :meth:`floodsph.walls.index.WallIndex.near_lists`; ``seg`` the wall segments.
     With ``cap`` (a time step), no h grows beyond what ``nl`` holds (:meth:`NeighbourList.h_cap`),
     so the lists stay valid through the solve, and none shrinks below ``H_SHRINK_MIN`` times its
-    guess (see the module docstring).
+    guess (see the module docstring); ``unmoved``: the particles are where ``nl`` was built.
     On return every particle has rho, h and alpha consistent with its neighbours to ``tol``,
     except the unconverged, capped and held ones, which take the plain summation at their h.
     Returns the :class:`DensityOutcome` counts.
     """
     iters = np.ones(p.n, dtype=np.int64)  # rows not solved count as converged
-    h_cap = nl.h_cap(p.x, p.y) if cap else np.full(p.n, np.inf)
+    h_cap = nl.h_cap(p.x, p.y, unmoved) if cap else np.full(p.n, np.inf)
     solve(nl.rows, p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked,
           wdist, *walls, seg, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0,
           integral, iters)
-    held = iters > max_iter
-    return DensityOutcome(iterations=int(np.abs(np.where(held, 0, iters)).max(initial=0)),
-                          unconverged=int((iters < 0).sum()), capped=int((iters == 0).sum()),
-                          held=int(held.sum()))
+    return DensityOutcome(*_outcome(iters, max_iter))
+
+
+@njit(cache=True)
+def _outcome(iters, max_iter):
+    """(iterations, unconverged, capped, held) of :class:`DensityOutcome` from the codes
+    ``iters`` of :func:`solve`, in one pass."""
+    most = 0
+    unconverged = 0
+    capped = 0
+    held = 0
+    for k in iters:
+        if k > max_iter:
+            held += 1
+        else:
+            most = max(most, abs(k))
+            unconverged += k < 0
+            capped += k == 0
+    return most, unconverged, capped, held
 
 
 class DensityOutcome(NamedTuple):

@@ -54,8 +54,8 @@ from numba import njit, prange
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.kernels import dwdr_over_r_cubic, dwdr_over_r_floored
 from floodsph.walls.geometry import mirror
-from floodsph.walls.images import corner_image, wall_image
-from floodsph.walls.sight import SIGHT_SLACK
+from floodsph.walls.images import corner_image
+from floodsph.walls.sight import SIGHT_SLACK, hides
 
 LAX_FRIEDRICHS = 0
 RIEMANN = 1
@@ -267,10 +267,10 @@ def _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme):
     x_j' = 2 f_j - x_j, free-slip velocity v_j' = v_j - 2 (v_j . n) n, and j's renormalisation
     tensor reflected, R K_j R with R = I - 2 n n^T; zeros when the wall does not hide the
     image's point from i (MVBP mirror particles, method notes 3.1)."""
-    xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
-    if not ok:
+    # wall_image's mirror and hides, with the mirror's normal kept for the velocity
+    xm, ym, _, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+    if not hides(x[i], y[i], xm, ym, seg, s):
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    _, _, _, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
     vn = u[j] * nx + v[j] * ny
     um = u[j] - 2.0 * vn * nx
     vm = v[j] - 2.0 * vn * ny
@@ -374,13 +374,44 @@ def apply_friction(u, v, rho, manning, dt, d_floor):
         v[i] *= k
 
 
+@njit(inline="always", cache=True)
+def _dt_bound(u, v, rho, h):
+    """h / (|v| + c) [s] of one particle (c = sqrt(g d)), inf if it is still and dry."""
+    c = math.sqrt(GRAVITY * rho / RHO_WATER)
+    w = math.sqrt(u * u + v * v) + c
+    return h / w if w > 0.0 else np.inf
+
+
 @njit(parallel=True, cache=True)
 def stable_dt(u, v, rho, h, cfl):
     """CFL time step dt = cfl min_i h_i / (|v_i| + c_i), c_i = sqrt(g d_i) [s]."""
     best = np.inf
     for i in prange(u.shape[0]):
-        c = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
-        w = math.sqrt(u[i] * u[i] + v[i] * v[i]) + c
-        if w > 0.0:
-            best = min(best, h[i] / w)
+        best = min(best, _dt_bound(u[i], v[i], rho[i], h[i]))
+    return cfl * best
+
+
+@njit(parallel=True, cache=True)
+def kick(u, v, ax, ay, half):
+    """Half kick v <- v + a dt / 2 of every particle (``half`` = dt / 2 [s])."""
+    for i in prange(u.shape[0]):
+        u[i] += half * ax[i]
+        v[i] += half * ay[i]
+
+
+@njit(parallel=True, cache=True)
+def close_step(u, v, ax, ay, half, rho, h, manning, dt, d_floor, cfl):
+    """The end of a step in one pass: the closing half kick (:func:`kick`), implicit Manning
+    friction over dt (:func:`apply_friction`), and the next CFL step of :func:`stable_dt`,
+    which is returned [s]."""
+    best = np.inf
+    for i in prange(u.shape[0]):
+        u[i] += half * ax[i]
+        v[i] += half * ay[i]
+        n = manning[i]
+        if n > 0.0:
+            k = friction_factor(u[i], v[i], rho[i], n, dt, d_floor)
+            u[i] *= k
+            v[i] *= k
+        best = min(best, _dt_bound(u[i], v[i], rho[i], h[i]))
     return cfl * best

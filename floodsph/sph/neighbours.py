@@ -395,11 +395,14 @@ class NeighbourList:
         grow, move = _motion(x, y, h, self.x_built, self.y_built, self.h_built)
         return grow + move <= 1.0 + self.skin
 
-    def h_cap(self, x, y) -> np.ndarray:
+    def h_cap(self, x, y, unmoved: bool = False) -> np.ndarray:
         """Largest smoothing lengths [m] the list still holds at the current positions:
-        h_b,i (1 + skin - D), so that G + D <= 1 + skin in :meth:`still_valid`."""
+        h_b,i (1 + skin - D), so that G + D <= 1 + skin in :meth:`still_valid`.
+        ``unmoved``: the caller knows that x, y are the positions of the build (D = 0)."""
         if x.shape[0] == 0:
             return self.h_built.copy()
+        if unmoved:
+            return self.h_built * (1.0 + self.skin - 0.0)
         _, move = _motion(x, y, self.h_built, self.x_built, self.y_built, self.h_built)
         return self.h_built * (1.0 + self.skin - move)
 
