@@ -11,8 +11,8 @@ solutions those of ``floodsph.testing``.
     NUMBA_NUM_THREADS=2 python workflows/validation_pages.py --case ritter [--out DIR] [--quick]
 
 ``--quick`` runs the coarsest spacing only (a check of the page, seconds once compiled). Every
-kernel is compiled on a small run first, outside the timings. Wall times are of the machine and
-the moment: the page says how loaded the machine was.
+kernel is compiled first by an untimed run of the coarsest spacing in each mode. Wall times
+are of the machine and the moment: the page says how loaded the machine was.
 """
 
 from __future__ import annotations
@@ -98,7 +98,8 @@ class Machine:
 
 def run_case(case: str, quick: bool) -> tuple[list[cases.CaseResult], Machine]:
     """Every run of a page, the default numerics first at each spacing."""
-    cases.ritter(20.0, refinement=Refinement.SPLIT_COALESCE)  # compile outside the timings
+    for mode in MODES:  # compile every kernel the case uses outside the timings
+        cases.CASES[case](SPACINGS[case][0], refinement=mode)
     t0, load0 = time.perf_counter(), os.getloadavg()[0]
     rows = []
     for dx in SPACINGS[case][:1] if quick else SPACINGS[case]:
