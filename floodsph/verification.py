@@ -2,8 +2,8 @@
 
 Each case builds a ``FloodModel`` on an analytic bed with ``Terrain.from_function``, runs it
 and returns the error against the exact solution of ``floodsph.testing``, with the cost
-counters a speed-against-error study needs. Used by the slow tests and by
-``workflows/speed_vs_error.py``.
+counters a speed-against-error study needs and the depth profile at the end time. Used by the
+slow tests, ``workflows/speed_vs_error.py`` and ``workflows/validation_pages.py``.
 
 Errors are measured on the Shepard-interpolated depth field of the output maps
 (``floodsph.output.rasterise.interpolate``, dry = 0 where the kernel support is below half):
@@ -31,6 +31,49 @@ from floodsph.output.rasterise import interpolate
 from floodsph.terrain import Terrain
 
 
+@dataclass(frozen=True)
+class DamBreak:
+    """A dam break in a closed, flat, frictionless channel along x [m, s]."""
+
+    d_left: float
+    """depth upstream of the dam [m]"""
+    d_right: float
+    """depth downstream of the dam [m]; 0 is Ritter's dry bed"""
+    x_dam: float = 1000.0
+    length: float = 2000.0
+    width: float = 100.0
+    t_end: float = 50.0
+    cell: float = 10.0
+    """cell of the analytic bed's grid [m]"""
+
+
+@dataclass(frozen=True)
+class Basin:
+    """Thacker's paraboloid b = h0 (x^2 + y^2)/a^2 in a square of side 2 half_width [m]."""
+
+    h0: float = 10.0
+    a: float = 3000.0
+    eta: float = 1500.0
+    half_width: float = 5000.0
+    cell: float = 50.0
+
+
+RITTER = DamBreak(10.0, 0.0)
+STOKER = DamBreak(10.0, 2.0)
+THACKER = Basin()
+
+
+@dataclass
+class Profile:
+    """Depth [m] along a line at the end time: the run's (Shepard-interpolated) and the exact
+    solution's, at positions ``x`` [m] along the line."""
+
+    x: np.ndarray
+    d: np.ndarray
+    d_exact: np.ndarray
+    line: str
+
+
 @dataclass
 class CaseResult:
     case: str
@@ -48,6 +91,7 @@ class CaseResult:
     splits: int = 0
     merges: int = 0
     time_stepping: str = "global"
+    profile: Profile | None = None
 
     @property
     def particle_steps_per_s(self) -> float:
@@ -110,66 +154,73 @@ def _channel_profile(model, xq):
     return _depth_at(model, X.ravel(), Y.ravel()).reshape(X.shape).mean(axis=0)
 
 
-def ritter(dx: float, kappa: float = Numerics.kappa, **numerics) -> CaseResult:
-    """Dry-bed dam break (Ritter), d0 = 10 m, t = 50 s; ``numerics``: fields of the model's
-    ``Numerics`` (``refinement`` default: ``Refinement.NONE``, uniform resolution)."""
-    d0, t_end = 10.0, 50.0
-    model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
-                           lambda x, y: np.where(x < 1000, d0, 0.0), dx, kappa,
-                           **numerics)
+def _dam_break(case: DamBreak, dx: float, kappa: float, numerics) -> tuple:
+    """Run a dam break; returns (model, initial volume, wall, particle-steps, pairs, x, d, exact
+    d) with the depth profile on 1 m bins along the channel."""
+    model = _lattice_model(lambda x, y: 0 * x, (0, case.length), (0, case.width), case.cell,
+                           lambda x, y: np.where(x < case.x_dam, case.d_left, case.d_right),
+                           dx, kappa, **numerics)
     v0 = model.volume()
-    wall, pst, pairs = _run(model, t_end)
-    xq = np.arange(0.5, 2000, 1.0)
+    wall, pst, pairs = _run(model, case.t_end)
+    xq = np.arange(0.5, case.length, 1.0)
     d = _channel_profile(model, xq)
-    d_ex, _ = exact.ritter(xq, t_end, d0, x_dam=1000.0)
+    d_ex, _ = exact.stoker(xq, case.t_end, case.d_left, case.d_right, x_dam=case.x_dam)
+    return model, v0, wall, pst, pairs, xq, d, d_ex
+
+
+def ritter(dx: float, kappa: float = Numerics.kappa, **numerics) -> CaseResult:
+    """Dry-bed dam break (Ritter), ``RITTER``: d0 = 10 m, t = 50 s; ``numerics``: fields of the
+    model's ``Numerics`` (``refinement`` default: ``Refinement.NONE``, uniform resolution)."""
+    c = RITTER
+    model, v0, wall, pst, pairs, xq, d, d_ex = _dam_break(c, dx, kappa, numerics)
     front = exact.front_position(xq, d, 0.1) - exact.front_position(xq, d_ex, 0.1)
     return CaseResult("ritter", dx, model.particles.n, model.steps, wall, pst, pairs,
                       exact.l1_relative(d, d_ex), float(front),
-                      abs(model.volume() - v0) / v0, *_labels(model))
+                      abs(model.volume() - v0) / v0, *_labels(model),
+                      Profile(xq, d, d_ex, "mean of four lines along the channel"))
 
 
 def stoker(dx: float, kappa: float = Numerics.kappa, **numerics) -> CaseResult:
-    """Wet-bed dam break (Stoker), 10 m over 2 m, t = 50 s."""
-    d_l, d_r, t_end = 10.0, 2.0, 50.0
-    model = _lattice_model(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
-                           lambda x, y: np.where(x < 1000, d_l, d_r), dx, kappa,
-                           **numerics)
-    v0 = model.volume()
-    wall, pst, pairs = _run(model, t_end)
-    xq = np.arange(0.5, 2000, 1.0)
-    d = _channel_profile(model, xq)
-    d_ex, _ = exact.stoker(xq, t_end, d_l, d_r, x_dam=1000.0)
-    d_m, _, _ = exact.stoker_middle_state(d_l, d_r)
-    right = xq > 1000
-    bore = xq[right][d[right] > 0.5 * (d_m + d_r)].max()
-    front = bore - exact.stoker_bore_position(t_end, d_l, d_r, x_dam=1000.0)
+    """Wet-bed dam break (Stoker), ``STOKER``: 10 m over 2 m, t = 50 s."""
+    c = STOKER
+    model, v0, wall, pst, pairs, xq, d, d_ex = _dam_break(c, dx, kappa, numerics)
+    d_m, _, _ = exact.stoker_middle_state(c.d_left, c.d_right)
+    right = xq > c.x_dam
+    bore = xq[right][d[right] > 0.5 * (d_m + c.d_right)].max()
+    front = bore - exact.stoker_bore_position(c.t_end, c.d_left, c.d_right, x_dam=c.x_dam)
     return CaseResult("stoker", dx, model.particles.n, model.steps, wall, pst, pairs,
                       exact.l1_relative(d, d_ex), float(front),
-                      abs(model.volume() - v0) / v0, *_labels(model))
+                      abs(model.volume() - v0) / v0, *_labels(model),
+                      Profile(xq, d, d_ex, "mean of four lines along the channel"))
 
 
 def thacker(dx: float, kappa: float = Numerics.kappa, periods: float = 1.0,
             **numerics) -> CaseResult:
-    """Thacker's planar surface in a paraboloid, frictionless, over ``periods`` periods."""
-    h0, a, eta = 10.0, 3000.0, 1500.0
+    """Thacker's planar surface in a paraboloid (``THACKER``), frictionless, over ``periods``
+    periods; the profile is along the x axis through the basin's centre."""
+    c = THACKER
+    h0, a, eta, w = c.h0, c.a, c.eta, c.half_width
     t_end = periods * exact.thacker_period(h0, a)
     model = _lattice_model(
-        lambda x, y: h0 * (x**2 + y**2) / a**2, (-5000, 5000), (-5000, 5000), 50.0,
+        lambda x, y: h0 * (x**2 + y**2) / a**2, (-w, w), (-w, w), c.cell,
         lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[0], dx, kappa,
         u=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[1],
         v=lambda x, y: exact.thacker_planar(x, y, 0.0, h0, a, eta)[2], **numerics)
     v0 = model.volume()
     wall, pst, pairs = _run(model, t_end)
-    xq = np.arange(-4975.0, 5000.0, 50.0)
+    xq = np.arange(-w + c.cell / 2, w, c.cell)
     X, Y = np.meshgrid(xq, xq)
-    d = _depth_at(model, X.ravel() + 5000.0, Y.ravel() + 5000.0)
+    d = _depth_at(model, X.ravel() + w, Y.ravel() + w)
     d_ex = exact.thacker_planar(X.ravel(), Y.ravel(), t_end, h0, a, eta)[0]
     wet = d_ex > 0
     l1 = float(np.abs(d - d_ex)[wet].sum() / d_ex[wet].sum())
     r_wet = np.hypot(X.ravel() - eta, Y.ravel())[(d > 1e-3)]
     shore = float(r_wet.max() - a) if r_wet.size else np.nan
+    xl = np.arange(-w + 5.0, w, 10.0)
+    line = Profile(xl, _depth_at(model, xl + w, np.full(xl.shape, w)),
+                   exact.thacker_planar(xl, 0.0 * xl, t_end, h0, a, eta)[0], "y = 0")
     return CaseResult("thacker", dx, model.particles.n, model.steps, wall, pst, pairs, l1,
-                      shore, abs(model.volume() - v0) / v0, *_labels(model))
+                      shore, abs(model.volume() - v0) / v0, *_labels(model), line)
 
 
 CASES = {"ritter": ritter, "stoker": stoker, "thacker": thacker}

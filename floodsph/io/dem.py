@@ -32,6 +32,7 @@ from rasterio.warp import calculate_default_transform, reproject
 from scipy import ndimage
 
 from floodsph.checks.elevation import check_elevations, vertical_unit
+from floodsph.checks.roughness import N_DEFAULT
 from floodsph.errors import InputError, warn
 from floodsph.io.manning import manning_grid
 from floodsph.io.raster import Grid, GridHeader, read_grid
@@ -52,7 +53,7 @@ def load_terrain(
     *,
     crs=None,
     dem_variable: str | None = None,
-    manning=0.035,
+    manning=N_DEFAULT,
     landcover=None,
     manning_table=None,
     extent=None,

@@ -27,6 +27,7 @@ from rasterio.enums import Resampling
 from rasterio.transform import Affine
 
 from floodsph.checks.roughness import (
+    N_DEFAULT,
     N_STRICKLER,
     check_manning_grid,
     check_manning_number,
@@ -90,7 +91,7 @@ def manning_grid(
     crs: CRS,
     valid: np.ndarray,
     *,
-    manning=0.035,
+    manning=N_DEFAULT,
     landcover=None,
     manning_table=None,
     warnings: list[str] | None = None,
@@ -142,7 +143,7 @@ def manning_grid(
             raise InputError(f"terrain.manning must be > 0, got {manning!r}")
         check_manning_number(value, "terrain.manning", warnings)
         return np.full(shape, value, dtype=np.float64)
-    fallback = float(np.median(n[valid])) if valid.any() else 0.035
+    fallback = float(np.median(n[valid])) if valid.any() else N_DEFAULT
     return np.where(valid, n, fallback)
 
 
