@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 from conftest import load_workflow
 
-pages = load_workflow("validation_pages", Path(__file__).resolve().parents[1] / "workflows"
+pages = load_workflow("validation_pages", Path(__file__).resolve().parents[2] / "workflows"
                       / "validation_pages.py")
 
 BOUNDS = {"ritter": (0.05, 50.0), "stoker": (0.03, 20.0), "thacker": (0.06, 300.0)}
