@@ -46,7 +46,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import subprocess
 import sys
 import time
 from dataclasses import dataclass, field
@@ -56,6 +55,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import provenance  # noqa: E402
 import still_water_cases as cases  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
@@ -513,22 +513,8 @@ def tables(bench: Benchmark) -> list[str]:
 
 
 def machine_note(bench: Benchmark) -> str:
-    import numba
-
-    threads = numba.get_num_threads()
-    busy = max(bench.load) > threads + 0.5
-    return (f"{os.cpu_count()} cores, {threads} numba thread(s); 1-minute load average "
-            f"{bench.load[0]:.1f} at the start and {bench.load[1]:.1f} at the end"
-            + (" (above the threads used: other jobs shared the machine)" if busy else "")
-            + f"; {bench.wall_s:.0f} s in all. Wall times are of this machine and this run.")
-
-
-def commit() -> str:
-    try:
-        return subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
-                              capture_output=True, text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
+    return provenance.machine_note(bench.load, bench.wall_s,
+                                   "Wall times are of this machine and this run.")
 
 
 MEASURES = (
@@ -551,7 +537,7 @@ MEASURES = (
 def report(bench: Benchmark, picture: Path | None) -> str:
     lines = ["# Still water at walls, nodata borders, shores and buildings", "",
              f"Made by `{bench.command}` on {time.strftime('%Y-%m-%d')} at commit "
-             f"`{commit()}`; {machine_note(bench)}", "",
+             f"`{provenance.commit(REPO)}`; {machine_note(bench)}", "",
              "Each case is a scenario (DEM GeoTIFF, `[[initial_water]]`, `[[walls]]`, closed "
              "edges, default numerics) run with `floodsph.run.run_scenario`; "
              "`workflows/still_water.py` and `workflows/still_water_cases.py` say how each is "

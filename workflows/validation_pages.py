@@ -19,16 +19,19 @@ from __future__ import annotations
 
 import argparse
 import os
-import subprocess
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from floodsph import testing as exact
-from floodsph import verification as cases
-from floodsph.numerics import Numerics, Refinement
-from floodsph.output.tables import markdown
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import provenance  # noqa: E402
+
+from floodsph import testing as exact  # noqa: E402
+from floodsph import verification as cases  # noqa: E402
+from floodsph.numerics import Numerics, Refinement  # noqa: E402
+from floodsph.output.tables import markdown  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -86,14 +89,7 @@ class Machine:
     wall_s: float
 
     def note(self) -> str:
-        import numba
-
-        threads = numba.get_num_threads()
-        busy = max(self.load) > threads + 0.5
-        return (f"{os.cpu_count()} cores, {threads} numba thread(s); 1-minute load average "
-                f"{self.load[0]:.1f} at the start and {self.load[1]:.1f} at the end"
-                + (" (above the threads used: other jobs shared the machine)" if busy else "")
-                + f"; {self.wall_s:.0f} s in all. Wall times are indicative only.")
+        return provenance.machine_note(self.load, self.wall_s, "Wall times are indicative only.")
 
 
 def run_case(case: str, quick: bool) -> tuple[list[cases.CaseResult], Machine]:
@@ -164,17 +160,10 @@ def plot(path: Path, rows: list[cases.CaseResult]) -> Path | None:
     return path
 
 
-def commit() -> str:
-    try:
-        return subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
-                              capture_output=True, text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
 def page(case: str, rows, machine: Machine, picture: Path | None, command: str) -> str:
     lines = [f"# {TITLES[case]}", "",
-             f"Made by `{command}` on {time.strftime('%Y-%m-%d')} at commit `{commit()}`; "
+             f"Made by `{command}` on {time.strftime('%Y-%m-%d')} at commit "
+             f"`{provenance.commit(REPO)}`; "
              f"{machine.note()}", "",
              "## Set-up", "", *setup_text(case), "",
              "## Error against the exact solution", "",
