@@ -127,6 +127,7 @@ class FloodModel:
         self.blocked = np.empty(0, dtype=np.bool_)
         self.wdist = np.empty(0)
         self.integral_walls = numerics.wall_model is WallModel.INTEGRAL
+        self._no_images = (None,)  # the integral walls' image-free lists, per list build
         self.walled = np.zeros(0, dtype=np.bool_)
         self._blocked_nl = None
         self._nl_fresh = False  # lists built in this step
@@ -486,8 +487,11 @@ class FloodModel:
         wstart, wseg, cstart, cpair = self.walls_near
         if not self.integral_walls:
             return self.wdist, wstart, wseg, cstart, cpair
-        far = np.full(wseg.shape[0], np.inf)
-        return far, wstart, wseg, np.zeros_like(cstart), cpair[:0]
+        if self._no_images[0] is not self.walls_near:  # once per build of the lists
+            self._no_images = (self.walls_near, np.full(wseg.shape[0], np.inf),
+                               np.zeros_like(cstart), cpair[:0])
+        _, far, no_corners, no_pairs = self._no_images
+        return far, wstart, wseg, no_corners, no_pairs
 
     def _solve_density(self, settle: bool = False) -> None:
         """The depth-density solve.

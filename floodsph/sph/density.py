@@ -170,6 +170,8 @@ def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, w
     stops at h_cap with the summation there, and ``iters[i]`` is set to 0 (capped). One whose
     iterate would fall below ``h_shrink`` times its incoming h stops there with the summation
     at that h, and ``iters[i]`` is set to ``max_iter + 1`` (held; ``h_shrink = 0``: no bound).
+    With ``integral`` (``wall_model = "integral"``) each summation next to a wall is divided by
+    the water fraction of the support (:func:`wall_corrected`).
     The iteration starts from h_i = h(rho_i) of (2) (within the bounds and the cap), not from
     the h it comes with: a particle that last took a plain summation (capped, unconverged, or
     at a bound of h) carries an h that does not satisfy (2), and an isolated one, whose
