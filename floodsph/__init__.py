@@ -18,11 +18,11 @@ from floodsph._version import __version__
 
 #: Public name -> the module that defines it.
 _PUBLIC = {
-    "load_scenario": "floodsph.scenario",
-    "Scenario": "floodsph.scenario",
+    "load_scenario": "floodsph.scenario.reader",
+    "Scenario": "floodsph.scenario.config",
     "run_scenario": "floodsph.api",
-    "RunResult": "floodsph.results",
-    "open_run": "floodsph.results",
+    "RunResult": "floodsph.run.results",
+    "open_run": "floodsph.run.results",
     "InputError": "floodsph.errors",
 }
 

@@ -1,8 +1,8 @@
 """The public calls of the package root: run a scenario from Python and get its results.
 
 ``floodsph.run_scenario`` is :func:`run_scenario` here: the run chain of
-:func:`floodsph.run.run_scenario` (which returns the bare ``run.json`` dict, as the command
-line and the workflows use it), returning a :class:`~floodsph.results.RunResult` instead.
+:func:`floodsph.run.pipeline.run_scenario` (which returns the bare ``run.json`` dict, as the command
+line and the workflows use it), returning a :class:`~floodsph.run.results.RunResult` instead.
 See ``docs/api.md``.
 """
 
@@ -10,8 +10,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from floodsph.results import RunResult
-from floodsph.scenario import Scenario, load_scenario
+from floodsph.run.results import RunResult
+from floodsph.scenario.config import Scenario
+from floodsph.scenario.reader import load_scenario
 
 
 def run_scenario(
@@ -25,11 +26,11 @@ def run_scenario(
     resume: bool = False,
     callbacks=(),
 ) -> RunResult:
-    """Run a scenario (a :class:`~floodsph.scenario.Scenario` or the path of its TOML file)
-    into its run folder and return the :class:`~floodsph.results.RunResult`.
+    """Run a scenario (a :class:`~floodsph.scenario.config.Scenario` or the path of its TOML file)
+    into its run folder and return the :class:`~floodsph.run.results.RunResult`.
 
     ``out_dir`` defaults to the scenario's ``output.directory`` (``out/<name>`` beside the
-    scenario file). The keyword options are those of :func:`floodsph.run.run_scenario`:
+    scenario file). The keyword options are those of :func:`floodsph.run.pipeline.run_scenario`:
     ``max_steps`` (a trial run), ``progress`` (the progress bar), ``overwrite`` (replace a
     completed run), ``threads`` (numba threads, 0 = all), ``resume`` (continue from the last
     checkpoint), ``callbacks`` (extra ``(callable, schedule)`` pairs).
@@ -39,7 +40,7 @@ def run_scenario(
     floodsph.errors.InputError
         Bad input, a run folder the run may not write, or a run too large for the memory.
     """
-    from floodsph import run
+    from floodsph.run.pipeline import pipeline as run
 
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)

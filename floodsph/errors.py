@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-log = logging.getLogger("floodsph.inputs")
+log = logging.getLogger("floodsph.inputs.prepare")
 
 
 class InputError(Exception):
@@ -18,8 +18,9 @@ class InputError(Exception):
 def warn(message: str, warnings: list[str] | None) -> None:
     """Report an input the user may mean but should look at again.
 
-    The message is logged at WARNING level (logger ``floodsph.inputs``) and, when
-    ``warnings`` is a list, appended to it (``floodsph.inputs.Inputs.warnings``, which the run
+    The message is logged at WARNING level (logger ``floodsph.inputs.prepare``) and, when
+    ``warnings`` is a list, appended to it (``floodsph.inputs.prepare.Inputs.warnings``, which the
+    run
     records in ``run.json``).
     """
     log.warning("%s", message)

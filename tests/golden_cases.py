@@ -14,15 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
-from floodsph.numerics import Refinement, TimeStepping
+from floodsph.scenario.numerics import Refinement, TimeStepping
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
 THREADS = 2
 
 
 def _analytic(name: str, dx: float, **options) -> dict:
-    """One ``floodsph.verification`` case, with its depth profile along the channel."""
-    from floodsph import verification
+    """One ``floodsph.verification.cases`` case, with its depth profile along the channel."""
+    from floodsph.verification.cases import cases as verification
 
     result = verification.CASES[name](dx, **options)
     return {"particles": result.particles, "steps": result.steps,
@@ -40,8 +40,8 @@ def _scenario_run(tmp: Path) -> dict:
     from conftest import valley_elevation, write_geotiff
     from run_cases import write_dam_break
 
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     write_geotiff(tmp / "dem.tif", valley_elevation())
     m = run_scenario(load_scenario(write_dam_break(tmp, "local")), tmp / "run", progress=False)

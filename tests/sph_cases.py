@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from floodsph.initial import particles_at
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
-from floodsph.particles import ParticleSet
-from floodsph.terrain import Terrain
+from floodsph.inputs.initial_water import particles_at
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.particles import ParticleSet
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics
 
 
 def lattice(x0, x1, y0, y1, dx):
@@ -18,7 +18,8 @@ def lattice(x0, x1, y0, y1, dx):
 
 
 def particles_with_depth(x, y, d, dx, kappa, u=0.0, v=0.0) -> ParticleSet:
-    """Particles of volume d dx^2 at (x, y) where d > 0 (``floodsph.initial.particles_at``)."""
+    """Particles of volume d dx^2 at (x, y) where d > 0
+    (``floodsph.inputs.initial_water.particles_at``)."""
     return particles_at(x, y, d, dx, kappa, u=u, v=v)
 
 

@@ -1,7 +1,8 @@
 """The cost of checkpoints on Malpasset at 20 m: their size, and their time as a share of the run.
 
 Runs the Malpasset scenario (``workflows/malpasset``; the sea as particles, floodsph's default
-numerics) through ``floodsph.run.run_scenario`` with ``[output] checkpoint_interval_s`` set,
+numerics) through ``floodsph.run.pipeline.run_scenario`` with ``[output] checkpoint_interval_s``
+set,
 and reads from ``run.json`` what the run spent writing checkpoints
 (``checkpoint_wall_time_s``, ``checkpoints_written``, ``checkpoint_bytes``) against its wall
 time. Writes the table to ``docs/checkpoint-cost.md``. It is a benchmark, not a test: run it
@@ -28,8 +29,8 @@ def measure(folder: Path, out: Path, end_time: float, interval: float) -> dict:
     """Run Malpasset with checkpoints every ``interval`` s; the cost figures of its run.json."""
     from tomli_w import dumps
 
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     path = setup.write_scenario(folder, out, "particles", end_time, 20.0)
     data = tomllib.loads(path.read_text(encoding="utf-8"))

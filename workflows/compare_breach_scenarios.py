@@ -14,8 +14,9 @@ Variants of the base (default ``data_samples/valley/scenario.toml``):
 
 Each variant is written as a scenario TOML (``tomli_w``, from the base's resolved
 copy: absolute paths, every default filled) into ``<out>/scenarios/``, run with
-``floodsph.run.run_scenario`` into ``<out>/runs/<variant>/``, and compared with the base by
-``floodsph.compare.compare`` (model = variant, reference = base; wet = depth > ``--threshold``,
+``floodsph.run.pipeline.run_scenario`` into ``<out>/runs/<variant>/``, and compared with the base by
+``floodsph.output.compare.compare`` (model = variant, reference = base; wet = depth >
+``--threshold``,
 default 0.1 m, Wing et al. 2017). Written into the results folder:
 
 * ``differences/<variant>/``: ``difference.tif`` (max depth, variant - base [m], NaN where
@@ -69,7 +70,7 @@ class Variant:
 def base_data(base_path: Path, end_time: float | None = None,
               spacing: float | None = None) -> dict:
     """The base scenario's resolved dict (absolute paths), with optional overrides."""
-    from floodsph.scenario import load_scenario
+    from floodsph.scenario.reader import load_scenario
 
     data = load_scenario(base_path).to_dict()
     if end_time is not None:
@@ -185,7 +186,7 @@ def compare_with_base(v: Variant, runs: Path, out: Path, threshold: float,
     """The summary row and per-gauge arrival rows of variant ``v`` against the base."""
     import json
 
-    from floodsph.compare import compare, write_outputs
+    from floodsph.output.compare import compare, write_outputs
 
     run = json.loads((runs / v.name / "run.json").read_text())
     result = compare(runs / v.name / "max_depth.tif", runs / "base" / "max_depth.tif",
@@ -261,8 +262,8 @@ def run_study(base_path: Path, out: Path, end_time=None, spacing=None, max_steps
               overwrite=False, threshold=0.1, manning_factors=(0.8, 1.2),
               level_deltas=(-1.0, 1.0), breach_factors=(0.5, 1.5)) -> list[dict]:
     """Write, run and compare every variant; returns the summary rows (base first)."""
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     out = Path(out).resolve()
     base = base_data(Path(base_path), end_time, spacing)

@@ -85,8 +85,8 @@ def run_sizes(ensemble: Path, sizes: list[int], out: Path, workers=None,
     from floodsph.ensemble.engine import machine_cores, open_client, plan_workers
     from floodsph.ensemble.runner import prepare_base, run_ensemble
     from floodsph.ensemble.spec import load_ensemble
-    from floodsph.memory import available_memory
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.memory import available_memory
+    from floodsph.scenario.reader import load_scenario
 
     spec = load_ensemble(ensemble)
     available, _ = available_memory()

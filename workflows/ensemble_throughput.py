@@ -7,7 +7,8 @@ K members (``--members``, default 8) of the ensemble file (default
    1 worker x 2 threads and with 2 workers x 1 thread: the wall time from start to finish
    (ensemble.json ``wall_time_s``) gives ``members_per_hour`` = K / wall x 3600;
 2. alone, right after each ensemble: each member's ``scenario.toml`` through
-   ``floodsph.run.run_scenario`` in this process with the configuration's threads (after one
+   ``floodsph.run.pipeline.run_scenario`` in this process with the configuration's threads (after
+   one
    untimed warm-up run, the compiled kernels loaded from numba's cache):
    ``member_alone_s`` is their mean.
 
@@ -56,8 +57,8 @@ def timed(function, *args, **kwargs) -> tuple[object, float]:
 
 def alone_times(folders: list[Path], threads: int, scratch: Path) -> list[float]:
     """Wall time [s] of ``run_scenario`` on each member's scenario alone in this process."""
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     out = []
     for folder in folders:
@@ -112,7 +113,7 @@ def measure(ensemble: Path, members: int, out: Path) -> list[dict]:
     """
     from floodsph.ensemble.runner import run_ensemble
     from floodsph.ensemble.spec import load_ensemble
-    from floodsph.scenario import load_scenario
+    from floodsph.scenario.reader import load_scenario
 
     spec = replace(load_ensemble(ensemble), members=members)
     base = load_scenario(spec.base)

@@ -1,6 +1,7 @@
 """Is still water seeded on the square lattice a stable state? Two measures per kappa = h0 / dx.
 
-floodsph seeds water on a square lattice (``floodsph.initial``). In still water on a flat
+floodsph seeds water on a square lattice (``floodsph.inputs.initial_water``). In still water on a
+flat
 bed the lattice is an equilibrium; whether it is a stable one decides whether a lake stays
 still or starts to stir itself after a few minutes.
 
@@ -43,11 +44,11 @@ import math
 import numpy as np
 from numba import njit
 
-from floodsph.initial import seed_particles
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
+from floodsph.inputs.initial_water import seed_particles
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics
 from floodsph.sph.kernels import w_cubic
-from floodsph.terrain import Terrain
 
 
 @njit(cache=True)
@@ -132,7 +133,7 @@ def bowl_lake(end_time: float, every: float = 100.0, spacing: float = 10.0,
               level: float = 5.0):
     """(t [s], max speed [m/s], 95th-percentile speed [m/s], max |level - ``level``| [m])
     every ``every`` s of the still lake in the parabolic bowl (module docstring), seeded as
-    runs seed water (``floodsph.initial.seed_particles``) at ``spacing`` [m]."""
+    runs seed water (``floodsph.inputs.initial_water.seed_particles``) at ``spacing`` [m]."""
 
     def bowl(x, y):
         return 10.0 * ((x - 500.0) ** 2 + (y - 500.0) ** 2) / 500.0**2

@@ -1,8 +1,8 @@
 """Where a run's time goes: wall time per stage of the time step, and list builds per step.
 
 Runs a scenario (the model of ``floodsph run``, without its outputs) for ``--steps`` steps or
-up to ``--end-time`` and times the stages of ``floodsph.model.FloodModel.step`` with the
-model's stage timer (``floodsph.stage_timer``: kick and drift, boundaries, refinement,
+up to ``--end-time`` and times the stages of ``floodsph.model.flood_model.FloodModel.step`` with the
+model's stage timer (``floodsph.model.stage_timer``: kick and drift, boundaries, refinement,
 neighbour lists, density, forces, closing kick). Times are exclusive; the time outside the
 steps is ``other``. Prints a markdown
 table and the neighbour-list builds per step. The first steps compile the numba kernels when
@@ -32,13 +32,13 @@ def profile(model, steps: int | None = None, end_time: float | None = None,
             warmup: int = 3) -> tuple[list[dict], dict]:
     """Step ``model`` and time its stages; returns (rows, totals).
 
-    ``rows`` has one dict per stage of ``floodsph.stage_timer`` (``stage``, ``seconds``,
+    ``rows`` has one dict per stage of ``floodsph.model.stage_timer`` (``stage``, ``seconds``,
     ``percent``), most costly first, and ``other`` for the time outside the steps; ``totals``
     the wall time, steps, particle-steps and neighbour-list builds per step (the model's
     ``neighbour_builds`` counter) of the timed steps. The timer is the model's public hook
     (``FloodModel.stage_timer``), removed again afterwards.
     """
-    from floodsph.stage_timer import StageTimer
+    from floodsph.model.stage_timer import StageTimer
 
     for _ in range(warmup):
         model.step()
@@ -106,9 +106,9 @@ def main(argv=None) -> int:
                     help="also time a map update at the end, best of N")
     args = ap.parse_args(argv)
     from floodsph.errors import InputError
-    from floodsph.inputs import prepare_inputs
-    from floodsph.run import build_model, set_threads
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.run.pipeline import build_model, set_threads
+    from floodsph.scenario.reader import load_scenario
 
     set_threads(args.threads)
     try:

@@ -1,7 +1,7 @@
 """The README's picture: the UK hazard map of the sample scenario.
 
 Runs ``data_samples/valley/scenario.toml`` (the synthetic valley's dam failure, 600 s) into a
-temporary run folder with ``floodsph.run.run_scenario`` and keeps the run's own quick-look
+temporary run folder with ``floodsph.run.pipeline.run_scenario`` and keeps the run's own quick-look
 ``hazard_uk.png`` as ``docs/images/sample_hazard.png``. Needs matplotlib
 (``pip install -e ".[plot]"``).
 
@@ -26,8 +26,8 @@ def main(argv: list[str] | None = None) -> Path:
     parser.add_argument("--threads", type=int, default=None, help="numba threads")
     args = parser.parse_args(argv)
 
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     with tempfile.TemporaryDirectory() as tmp:
         run = Path(tmp) / "run"

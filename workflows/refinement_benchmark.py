@@ -1,11 +1,11 @@
 """Cost and agreement of the refinement modes on the sample valley and on Malpasset.
 
 Runs each scenario with ``numerics.refinement`` = "none", "split" and "split+coalesce"
-through the real run chain (``floodsph.run.run_scenario``: run folder, maps, run.json) and
+through the real run chain (``floodsph.run.pipeline.run_scenario``: run folder, maps, run.json) and
 reports, per run: wall time, steps, peak and final particle counts, particle-steps (the sum
 over steps of the particle count, the solver's work measure), splits, merges and the mass
 error; and, for each pair of modes, the agreement of their ``max_depth.tif`` maps
-(``floodsph.compare``: CSI with wet = depth > 0.1 m, and RMSE / bias over cells wet in both).
+(``floodsph.output.compare``: CSI with wet = depth > 0.1 m, and RMSE / bias over cells wet in both).
 
 Scenarios: ``data_samples/valley/scenario.toml`` (its own end time, 600 s) and Malpasset
 (the scenario of ``workflows/malpasset``, the sea as particles, cut to 1000 s), written from

@@ -1,6 +1,6 @@
 """How the refined Ritter convergence study depends on the daughters' relaxed smoothing.
 
-Runs ``floodsph.verification.ritter`` (d0 = 10 m, t = 50 s) at 10, 5 and 2.5 m with
+Runs ``floodsph.verification.cases.ritter`` (d0 = 10 m, t = 50 s) at 10, 5 and 2.5 m with
 ``split+coalesce`` (or ``--mode split``) for each value of ``Numerics.refine_smoothing_excess``
 (split particles relax to h^2 rho = smoothing_excess kappa^2 m), and checks each row against
 the targets of issue 2:
@@ -31,16 +31,15 @@ from pathlib import Path
 
 import numpy as np
 
-from floodsph import testing as exact
-from floodsph import verification as cases
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics, Refinement
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.particles import ParticleSet
+from floodsph.model.refinement import Refiner
+from floodsph.model.terrain import Terrain
 from floodsph.output.tables import markdown
-from floodsph.particles import ParticleSet
-from floodsph.refinement import Refiner
-from floodsph.terrain import Terrain
+from floodsph.scenario.numerics import Numerics, Refinement
+from floodsph.verification.cases import cases, exact
 
 L1_AT_5M = 0.015
 ORDER_MIN = 0.8

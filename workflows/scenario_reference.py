@@ -1,6 +1,6 @@
 """Write ``docs/scenario-reference.md``: every table and key of the scenario file.
 
-The page is made from ``floodsph.scenario_keys.TABLES`` (type, units and meaning of each key)
+The page is made from ``floodsph.scenario.keys.TABLES`` (type, units and meaning of each key)
 and the defaults of the dataclasses the parser fills, so it shows what the code accepts.
 Re-run it after adding or changing a key; ``tests/scenario/test_scenario_reference.py`` fails while
 the committed page differs from what this script writes.
@@ -27,7 +27,7 @@ a complete example; `floodsph check SCENARIO` validates a file and its inputs.
 Tables written `[[name]]` may be repeated; a table that is not required may be left out.
 A default in quotes is a string; `none` means the feature is off unless the key is given.
 
-This page is generated from the code (`floodsph/scenario_keys.py` and the parser's
+This page is generated from the code (`floodsph/scenario/keys.py` and the parser's
 defaults) by `python workflows/scenario_reference.py`; do not edit it by hand.
 """
 
@@ -54,7 +54,7 @@ def table_section(table) -> list[str]:
 
 def render() -> str:
     """The whole page."""
-    from floodsph.scenario_keys import TABLES
+    from floodsph.scenario.keys import TABLES
 
     lines = [INTRO]
     for table in TABLES:

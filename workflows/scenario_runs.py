@@ -2,7 +2,7 @@
 
 Shared by ``refinement_benchmark.py`` and ``speed_vs_error.py``: a scenario is loaded, its
 refinement mode, particle spacing, end time or refinement thresholds replaced, and run through
-the real chain (``floodsph.run.run_scenario``: run folder, maps, ``run.json``, whose
+the real chain (``floodsph.run.pipeline.run_scenario``: run folder, maps, ``run.json``, whose
 ``particle_updates`` is the particle-steps, the solver's work measure).
 """
 
@@ -26,8 +26,8 @@ def variant(path: Path, out: Path, mode: str | None = None, spacing: float | Non
     [s]; ``settings``: ``[numerics]`` refinement keys (:data:`REFINE_KEYS`);
     ``time_stepping``: ``numerics.time_stepping`` (``"global"`` or ``"local"``).
     """
-    from floodsph.numerics import Refinement, TimeStepping
-    from floodsph.scenario import load_scenario
+    from floodsph.scenario.numerics import Refinement, TimeStepping
+    from floodsph.scenario.reader import load_scenario
 
     scenario = load_scenario(path)
     numerics = dict(settings or {})
@@ -48,7 +48,7 @@ def variant(path: Path, out: Path, mode: str | None = None, spacing: float | Non
 
 def run(scenario, out: Path, max_steps: int | None = None, **labels) -> dict:
     """Run ``scenario`` into ``out``; return its row: ``labels``, then cost and counters."""
-    import floodsph.run as runner
+    import floodsph.run.pipeline as runner
 
     t0 = time.perf_counter()
     manifest = runner.run_scenario(scenario, out, max_steps=max_steps, progress=False,
@@ -71,7 +71,7 @@ def run(scenario, out: Path, max_steps: int | None = None, **labels) -> dict:
 def agreement(run_a: Path, run_b: Path, threshold: float = WET_M) -> dict:
     """CSI (wet = depth > ``threshold``), hit rate, false-alarm ratio, and RMSE and bias of
     depth over cells wet in both, of run a's ``max_depth.tif`` against run b's."""
-    from floodsph.compare import compare
+    from floodsph.output.compare import compare
 
     s = compare(run_a / "max_depth.tif", run_b / "max_depth.tif", threshold=threshold).summary
     return {"csi": round(s["csi"], 4), "hit_rate": round(s["hit_rate"], 4),

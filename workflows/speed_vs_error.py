@@ -1,6 +1,6 @@
 """Speed against error of floodsph: analytic cases, real terrain, and raw solver throughput.
 
-* **Analytic cases** (``floodsph.verification``): Ritter and Stoker dam breaks and Thacker's
+* **Analytic cases** (``floodsph.verification.cases``): Ritter and Stoker dam breaks and Thacker's
   basin at three spacings each, in each refinement mode (default: all three, ``none``,
   ``split`` and ``split+coalesce``) and each time stepping (``--time-stepping``, default
   global; ``global local`` runs both); the error is the L1 relative depth error against the
@@ -53,13 +53,13 @@ import malpasset_setup as mp_setup  # noqa: E402
 import run_ea_test4 as ea4  # noqa: E402
 import scenario_runs as runs  # noqa: E402
 
-from floodsph import verification as cases  # noqa: E402
 from floodsph.constants import RHO_WATER  # noqa: E402
-from floodsph.model import FloodModel  # noqa: E402
-from floodsph.numerics import Numerics, Refinement, TimeStepping  # noqa: E402
+from floodsph.model.flood_model import FloodModel  # noqa: E402
+from floodsph.model.particles import ParticleSet  # noqa: E402
+from floodsph.model.terrain import Terrain  # noqa: E402
 from floodsph.output.tables import markdown, write_csv  # noqa: E402
-from floodsph.particles import ParticleSet  # noqa: E402
-from floodsph.terrain import Terrain  # noqa: E402
+from floodsph.scenario.numerics import Numerics, Refinement, TimeStepping  # noqa: E402
+from floodsph.verification.cases import cases  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 

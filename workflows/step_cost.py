@@ -1,11 +1,11 @@
 """The cost of one time step at 1,000 to 64,000 particles, stage by stage.
 
-A Ritter-like dam break (``floodsph.verification.ritter``'s channel: 10 m of still water
+A Ritter-like dam break (``floodsph.verification.cases.ritter``'s channel: 10 m of still water
 over the west half of a closed, flat 2000 m x 100 m channel, dry east half) is seeded at the
 spacings of :data:`SIZES` (10, 5, 2.5 and 1.25 m: about 1,000, 4,000, 16,000 and 64,000
 particles). Each measurement builds the model afresh, takes ``--warmup`` untimed steps (the
 kernels compile there on a first run) and then ``--steps`` timed steps, with the model's
-stage timer (``floodsph.stage_timer``) adding up the wall time of each stage. Reported per
+stage timer (``floodsph.model.stage_timer``) adding up the wall time of each stage. Reported per
 size: particle-steps/s, ms per step and the stages' share in us per step, medians over
 ``--repeats``; and a least-squares fit of the time per step, t = fixed + per_particle n, over
 the sizes: ``fixed`` is the cost of a step that does not grow with the particles.
@@ -48,10 +48,10 @@ def dam_break(spacing: float):
     public pieces only (``Terrain``, ``ParticleSet``, ``Numerics``), so that any checkout
     builds the same case."""
     from floodsph.constants import RHO_WATER
-    from floodsph.model import FloodModel
-    from floodsph.numerics import Numerics
-    from floodsph.particles import ParticleSet
-    from floodsph.terrain import Terrain
+    from floodsph.model.flood_model import FloodModel
+    from floodsph.model.particles import ParticleSet
+    from floodsph.model.terrain import Terrain
+    from floodsph.scenario.numerics import Numerics
 
     terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0.0, 2000.0), (0.0, 100.0), 10.0)
     x1 = np.arange(spacing / 2, 1000.0, spacing)
@@ -74,7 +74,7 @@ def measure(spacing: float, steps: int, warmup: int) -> dict:
         model.step()
     timer = None
     if hasattr(model, "stage_timer"):  # else a checkout from before the stage timer
-        from floodsph.stage_timer import StageTimer
+        from floodsph.model.stage_timer import StageTimer
 
         timer = model.stage_timer = StageTimer()
     updates = model.counters["particle_updates"]
@@ -94,7 +94,7 @@ def worker() -> int:
     """Serve measurements: one JSON request (spacing, steps, warmup) per stdin line, one JSON
     result per stdout line."""
     import floodsph
-    from floodsph.run import set_threads
+    from floodsph.run.pipeline import set_threads
 
     root = Path(os.environ["PYTHONPATH"]).resolve()
     if not Path(floodsph.__file__).resolve().is_relative_to(root):
@@ -216,7 +216,7 @@ def report(rows: list[dict], names: list[str], command: str) -> str:
              "Made by `workflows/step_cost.py` (its docstring describes the case and the "
              "stages):", "", f"    {command}", "",
              "Medians of the repeats. Stage times are microseconds per step (`us_<stage>`, "
-             "`floodsph.stage_timer`).", "", markdown(table, spec=".4g"), "",
+             "`floodsph.model.stage_timer`).", "", markdown(table, spec=".4g"), "",
              "Least-squares fit of ms per step = fixed + per particle x particles:", "",
              markdown(fits, spec=".4g")]
     if len(names) == 2:
@@ -259,7 +259,7 @@ def main(argv=None) -> int:
         checkouts = [Checkout("this", REPO, args.threads),
                      Checkout("ref", reference_root(args.compare, args.ref_dir), args.threads)]
     else:
-        from floodsph.run import set_threads
+        from floodsph.run.pipeline import set_threads
 
         set_threads(args.threads)
         checkouts = [InProcess()]

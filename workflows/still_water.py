@@ -2,7 +2,7 @@
 away from the lattice: the benchmark of floodsph's wall and shore model.
 
 Each case (``still_water_cases``) is a scenario folder run through the public chain
-(``floodsph.run.run_scenario``: default numerics, closed edges, run folder and maps); a
+(``floodsph.run.pipeline.run_scenario``: default numerics, closed edges, run folder and maps); a
 callback samples the particles (``sim.model.particles``) at ``SAMPLES`` report times.
 
 Still water: the largest and the 95th-percentile particle speed, and the level error
@@ -17,10 +17,10 @@ the reservoir, the ``max_speed.tif`` of the reservoir's cells (median, 95th perc
 max). A case passes when every figure with a target stays within it at every report time
 after t = 0 (the issue's targets, in the tables).
 
-The dam break: Ritter's solution (``floodsph.testing.ritter``) against the SPH depth
+The dam break: Ritter's solution (``floodsph.verification.exact.ritter``) against the SPH depth
 interpolated (``floodsph.output.rasterise.interpolate``) on four lines along the channel
 axis at 1/8, 3/8, 5/8 and 7/8 of its width (12.5, 37.5, 62.5 and 87.5 m, as
-``floodsph.verification.ritter``), L1 relative of their mean; the two lines next to the
+``floodsph.verification.cases.ritter``), L1 relative of their mean; the two lines next to the
 walls against the two middle ones (a wall-hugging jet makes the wall lines worse: targeted
 at no more than 25 % worse); the front error (last point deeper than 0.1 m); particles
 outside the channel at any report time. Targets: the L1 of the channel turned by 30 degrees
@@ -107,7 +107,7 @@ class Probe:
         self.outside_at_start: int | None = None
 
     def __call__(self, sim) -> None:
-        from floodsph.schedules import time_tolerance
+        from floodsph.simulation.schedules import time_tolerance
 
         model = sim.model
         if self.samples and abs(self.samples[-1].t - model.t) <= time_tolerance(model.t):
@@ -186,9 +186,9 @@ class CaseRun:
 def run_case(case: cases.Case, out: Path) -> CaseRun:
     """Run the case's scenario into ``out`` with a :class:`Probe` every end_time /
     ``SAMPLES`` s."""
-    import floodsph.run as runner
-    from floodsph.scenario import load_scenario
-    from floodsph.schedules import TimeInterval
+    import floodsph.run.pipeline as runner
+    from floodsph.scenario.reader import load_scenario
+    from floodsph.simulation.schedules import TimeInterval
 
     scenario = load_scenario(case.scenario)
     probe = Probe(case, scenario.output.wet_threshold_m)
@@ -233,8 +233,8 @@ def reservoir_figures(run: CaseRun) -> dict:
 def dam_break_figures(run: CaseRun) -> dict:
     """L1 of the mean depth profile against Ritter, of the lines next to the walls and of
     the middle lines, and the front error, at the end time."""
-    from floodsph import testing as exact
     from floodsph.output.rasterise import interpolate
+    from floodsph.verification.cases import exact
 
     ch = run.case.channel
     p = run.probe.particles
@@ -539,7 +539,7 @@ def report(bench: Benchmark, picture: Path | None) -> str:
              f"Made by `{bench.command}` on {time.strftime('%Y-%m-%d')} at commit "
              f"`{provenance.commit(REPO)}`; {machine_note(bench)}", "",
              "Each case is a scenario (DEM GeoTIFF, `[[initial_water]]`, `[[walls]]`, closed "
-             "edges, default numerics) run with `floodsph.run.run_scenario`; "
+             "edges, default numerics) run with `floodsph.run.pipeline.run_scenario`; "
              "`workflows/still_water.py` and `workflows/still_water_cases.py` say how each is "
              "built and measured. The synthetic beds are frictionless in effect "
              f"(n = {cases.FRICTIONLESS_N:g}), 5 m DEM cells and spacing (the dam break 10 m).",

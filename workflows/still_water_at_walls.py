@@ -9,7 +9,7 @@ Cases (flat, frictionless beds; walls as ``FloodModel(walls=...)`` polylines):
   10 m spacing (four convex corners);
 * ``large-building``: the same footprint in a 2 km x 1.5 km lake at 5 m spacing (118,400
   particles), for the set-up's cost on a larger domain;
-* ``ritter-3.78m``: Ritter's dam break (``floodsph.verification.ritter``) at the spacing
+* ``ritter-3.78m``: Ritter's dam break (``floodsph.verification.cases.ritter``) at the spacing
   10 / sqrt(7) m, where the channel's north wall lies 3.6 m beyond the last lattice row.
 
 For each case and set-up it prints the largest depth error at t = 0, the seeds the set-up
@@ -32,12 +32,12 @@ import time
 import numpy as np
 from matplotlib.path import Path
 
-from floodsph import verification
 from floodsph.constants import RHO_WATER
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
-from floodsph.particles import ParticleSet
-from floodsph.terrain import Terrain
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.particles import ParticleSet
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics
+from floodsph.verification.cases import cases as verification
 from floodsph.walls import seeding as wall_seeding
 
 CASES = ("turned-rectangle", "turned-building", "large-building", "ritter-3.78m")

@@ -2,7 +2,7 @@
 
 Every case is what a user would run: a DEM, ``[[initial_water]]``, ``[[walls]]`` polylines,
 closed edges and floodsph's default numerics, written into its own folder and run by
-``workflows/still_water.py`` through ``floodsph.run.run_scenario``.
+``workflows/still_water.py`` through ``floodsph.run.pipeline.run_scenario``.
 
 * ``rectangle``: 2 m of water in a 300 m x 180 m rectangle of walls (a closed polyline)
   turned by 0, 15, 30 and 45 degrees on a flat 5 m DEM, 5 m spacing;
@@ -12,7 +12,7 @@ closed edges and floodsph's default numerics, written into its own folder and ru
   shore r_s = 200 m lies on a 3 % slope (2 a r_s = 0.03);
 * ``building``: 2 m of water in a 400 m x 300 m basin around a 100 m square footprint
   turned by 30 degrees (a closed polyline; the water polygon has the footprint cut out);
-* ``dam-break``: Ritter's dam break of ``floodsph.verification`` (10 m of water behind a dam
+* ``dam-break``: Ritter's dam break of ``floodsph.verification.cases`` (10 m of water behind a dam
   half-way along a 2000 m x 100 m channel, dry downstream, 50 s, 10 m spacing) in a channel
   of walls along x and in one turned by 30 degrees;
 * ``malpasset``: the Malpasset reservoir at rest (20 m DEM, the reservoir at 100 m from
@@ -274,7 +274,7 @@ def building(folder: Path, end_time: float, quick: bool) -> Case:
 
 def dam_break(folder: Path, angle: float, end_time: float, quick: bool) -> Case:
     """Ritter's dam break in a channel of walls whose axis is turned by ``angle`` degrees,
-    measured at ``end_time`` [s] (``floodsph.verification.ritter``: 50 s).
+    measured at ``end_time`` [s] (``floodsph.verification.cases.ritter``: 50 s).
 
     The channel's upstream right-hand corner lies 50 m in from the DEM's south-west corner
     (at 30 degrees, 50 m in from the west and ``width sin 30`` higher, so the turned

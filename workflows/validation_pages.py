@@ -2,11 +2,11 @@
 
 Each page (``<out>/<case>.md``, default ``docs/validation``) gives the case's set-up, the L1
 relative depth error, front error, mass error and solver wall time at three particle spacings
-with the default numerics (``floodsph.numerics.Numerics()``: ``split+coalesce`` refinement,
+with the default numerics (``floodsph.scenario.numerics.Numerics()``: ``split+coalesce`` refinement,
 one global time step) and with refinement ``none``, and a figure beside it (``<case>.png``):
 the depth profile of each default run at the end time against the exact solution. The runs are
-those of ``floodsph.verification`` (the real solver path on an analytic bed) and the exact
-solutions those of ``floodsph.testing``.
+those of ``floodsph.verification.cases`` (the real solver path on an analytic bed) and the exact
+solutions those of ``floodsph.verification.exact``.
 
     NUMBA_NUM_THREADS=2 python workflows/validation_pages.py --case ritter [--out DIR] [--quick]
 
@@ -28,10 +28,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import provenance  # noqa: E402
 
-from floodsph import testing as exact  # noqa: E402
-from floodsph import verification as cases  # noqa: E402
-from floodsph.numerics import Numerics, Refinement  # noqa: E402
 from floodsph.output.tables import markdown  # noqa: E402
+from floodsph.scenario.numerics import Numerics, Refinement  # noqa: E402
+from floodsph.verification.cases import (
+    cases,  # noqa: E402
+    exact,  # noqa: E402
+)
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -48,7 +50,8 @@ TITLES = {"ritter": "Ritter: dam break onto a dry bed",
 
 
 def setup_text(case: str) -> list[str]:
-    """The page's set-up paragraph, from the case's parameters in ``floodsph.verification``."""
+    """The page's set-up paragraph, from the case's parameters in
+    ``floodsph.verification.cases``."""
     kappa = Numerics.kappa
     if case in ("ritter", "stoker"):
         c = cases.RITTER if case == "ritter" else cases.STOKER

@@ -1,13 +1,14 @@
 """floodsph against ANUGA's finite-volume solver on the same scenario and DEM.
 
 For each scenario TOML (default: the sample valley dam break, ``data_samples/valley``), the
-script runs floodsph (``floodsph.run.run_scenario``) and ANUGA 4 (Roberts et al., ANUGA user
+script runs floodsph (``floodsph.run.pipeline.run_scenario``) and ANUGA 4 (Roberts et al., ANUGA
+user
 manual, Geoscience Australia; flow algorithm DE0, a second-order well-balanced finite-volume
 scheme on triangles) on the same DEM, with the same Manning n, initial water, inflow
-hydrographs and end time, and compares the maximum-depth maps with ``floodsph.compare``
+hydrographs and end time, and compares the maximum-depth maps with ``floodsph.output.compare``
 (floodsph = model, ANUGA = reference; wet = depth > 0.1 m).
 
-ANUGA set-up, one-to-one with the floodsph inputs (``floodsph.inputs.prepare_inputs``):
+ANUGA set-up, one-to-one with the floodsph inputs (``floodsph.inputs.prepare.prepare_inputs``):
 
 * mesh: ``anuga.rectangular_cross_domain`` on the DEM grid, each DEM cell split into four
   triangles, in the same local frame (origin = lower-left DEM corner);
@@ -271,7 +272,7 @@ def run_anuga(scenario, inputs, walled: set[str], threads: int, work: Path) -> A
 
 def run_floodsph(scenario, out: Path, threads: int, progress: bool) -> dict:
     """A 2-step warm-up (compiles or loads the numba kernels), then the timed run."""
-    from floodsph.run import run_scenario
+    from floodsph.run.pipeline import run_scenario
 
     warm = out.parent / (out.name + "_warmup")
     run_scenario(scenario, out_dir=warm, max_steps=2, progress=False, overwrite=True,
@@ -347,9 +348,9 @@ def plot_side_by_side(path: Path, result, reference_on_model: np.ndarray) -> Pat
 def compare_scenario(path: Path, out: Path, end_time: float | None, threads: int,
                      progress: bool) -> dict:
     """Both runs, the comparison outputs and the summary row of one scenario."""
-    from floodsph.compare import align, compare, read_raster, write_outputs
-    from floodsph.inputs import prepare_inputs
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.output.compare import align, compare, read_raster, write_outputs
+    from floodsph.scenario.reader import load_scenario
 
     scenario = load_scenario(path)
     if end_time is not None:

@@ -1,4 +1,4 @@
-"""The contract every open boundary keeps with ``floodsph.model.FloodModel``.
+"""The contract every open boundary keeps with ``floodsph.model.flood_model.FloodModel``.
 
 A boundary takes part in a step through three calls, in this order:
 

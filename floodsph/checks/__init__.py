@@ -10,5 +10,5 @@ Each module checks one kind of input (the table of every check, its threshold an
 * :mod:`~floodsph.checks.water`: initial water bodies that hold no water, a dry scenario.
 
 Refusals raise :class:`floodsph.errors.InputError`; warnings go through
-:func:`floodsph.errors.warn` into ``floodsph.inputs.Inputs.warnings``.
+:func:`floodsph.errors.warn` into ``floodsph.inputs.prepare.Inputs.warnings``.
 """

@@ -20,10 +20,10 @@ def command(scenario: Path, output) -> None:
     a run whose memory estimate exceeds the memory available, and a run folder that a run
     could not write (a file, not writable, holding files that are not a run's).
     """
-    from floodsph.inputs import prepare_inputs, summary_lines
-    from floodsph.memory import available_memory, check_memory
-    from floodsph.run_folder import RunFolder
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.memory import available_memory, check_memory
+    from floodsph.inputs.prepare import prepare_inputs, summary_lines
+    from floodsph.run.folder import RunFolder
+    from floodsph.scenario.reader import load_scenario
 
     sc = load_scenario(scenario)
     output = None if output is None else Path(output)

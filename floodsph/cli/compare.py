@@ -28,7 +28,7 @@ def command(model, reference, threshold, points, arrival, out):
     counts, hit rate, false alarm ratio, CSI, F2, error bias and the depth (or arrival-time)
     RMSE and bias over cells wet in both.
     """
-    from floodsph.compare import compare, format_table, write_outputs
+    from floodsph.output.compare import compare, format_table, write_outputs
 
     result = compare(model, reference, threshold=threshold, points=points, arrival=arrival)
     click.echo(format_table(result.summary))

@@ -78,7 +78,7 @@ class LazyGroup(click.Group):
             if debug or isinstance(exc, click.ClickException | click.exceptions.Exit
                                              | click.Abort):
                 raise
-            from floodsph.run import error_message
+            from floodsph.run.pipeline import error_message
 
             click.echo(f"Error: {error_message(exc)}", err=True)
             ctx.exit(EXIT_FAILED)

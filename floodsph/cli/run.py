@@ -40,9 +40,9 @@ def command(ctx: click.Context, scenario: Path, output, overwrite: bool, resume:
     (Ctrl-C, SIGTERM or SIGHUP: a checkpoint is written first; exit status 130) or failed
     (exit status 1, or 2 for bad input). The maps are written only when the run completes.
     """
-    from floodsph.compile_notice import CompileNotice
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.run.compile_notice import CompileNotice
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     opts = ctx.obj or {}
     quiet = opts.get("quiet", False)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from floodsph.scenario_schema import Reader, describe, is_number, join
+from floodsph.scenario.schema import Reader, describe, is_number, join
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 A key path is a chain of table keys and array indices, ``terrain.manning``,
 ``initial_water[0].level_m``, ``inflows[0].breach.average_width_m`` or
-``inflows[0].direction[1]`` (``floodsph.scenario_schema.join`` builds the same strings). It is
+``inflows[0].direction[1]`` (``floodsph.scenario.schema.join`` builds the same strings). It is
 looked up in the resolved base scenario (``Scenario.to_dict()``: absolute paths, defaults
 filled):
 
@@ -23,7 +23,7 @@ import copy
 import re
 from dataclasses import dataclass, fields
 
-from floodsph.scenario_schema import join
+from floodsph.scenario.schema import join
 
 #: Returned by :func:`lookup` for a key the scenario accepts but the base scenario leaves out.
 MISSING = object()
@@ -69,8 +69,7 @@ class KeyPath:
 def _table_keys() -> dict[str, tuple[str, ...]]:
     """The keys each scenario table accepts, by table pattern (from the scenario's classes)."""
     from floodsph.breach.params import BreachParams
-    from floodsph.numerics import SCENARIO_KEYS as NUMERICS_KEYS
-    from floodsph.scenario import (
+    from floodsph.scenario.config import (
         TOP_KEYS,
         Gauges,
         Inflow,
@@ -81,6 +80,7 @@ def _table_keys() -> dict[str, tuple[str, ...]]:
         TerrainConfig,
         Wall,
     )
+    from floodsph.scenario.numerics import SCENARIO_KEYS as NUMERICS_KEYS
 
     def names(cls):
         return tuple(f.name for f in fields(cls) if f.metadata.get("scenario", True))

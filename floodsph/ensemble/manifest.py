@@ -15,7 +15,7 @@ ones), ``"interrupted"`` or ``"failed"`` (no member completed, or the ensemble i
 ``mode = "factor"`` parameter the factor), ``status`` (a member's run status, or
 ``"not run"``), ``wall_time_s``, ``error``.
 
-Both files are written atomically (``floodsph.atomic_files``), readable by the group.
+Both files are written atomically (``floodsph.run.atomic_files``), readable by the group.
 """
 
 from __future__ import annotations
@@ -26,8 +26,8 @@ import json
 from pathlib import Path
 
 from floodsph._version import __version__
-from floodsph.atomic_files import atomic_path
-from floodsph.manifest import json_safe, now_iso
+from floodsph.run.atomic_files import atomic_path
+from floodsph.run.manifest import json_safe, now_iso
 
 ENSEMBLE_JSON = "ensemble.json"
 SAMPLES_CSV = "samples.csv"

@@ -12,7 +12,7 @@ Before any member runs, :func:`build_members` checks
    map grid or the run folder (:data:`FIXED_KEYS`) cannot be sampled, because every member
    must map onto the base scenario's grid;
 2. each parameter's values alone, then each member's values together, with the scenario's own
-   validation (``floodsph.scenario.scenario_from_dict``), and a parametric breach's derived
+   validation (``floodsph.scenario.reader.scenario_from_dict``), and a parametric breach's derived
    set-up (``floodsph.breach.params.resolve``).
 
 Relative paths among sampled values (``distribution = "choice"`` of files) are relative to the
@@ -20,7 +20,7 @@ ensemble file. The members' maps must be GeoTIFFs (the aggregation reads them), 
 ``"geotiff"`` is added to ``output.formats`` if the base leaves it out.
 
 :func:`run_member` is what a dask worker executes for one member; it is the one place that
-calls :func:`floodsph.run.run_scenario`.
+calls :func:`floodsph.run.pipeline.run_scenario`.
 """
 
 from __future__ import annotations
@@ -35,8 +35,9 @@ from floodsph.ensemble.rasters import RASTER_KEYS, raster_name
 from floodsph.ensemble.sampling import Samples
 from floodsph.ensemble.spec import EnsembleSpec, Mode, Parameter
 from floodsph.errors import InputError
-from floodsph.scenario import Scenario, scenario_from_dict
-from floodsph.scenario_schema import is_number, join
+from floodsph.scenario.config import Scenario
+from floodsph.scenario.reader import scenario_from_dict
+from floodsph.scenario.schema import is_number, join
 
 MEMBERS_DIR = "members"
 SCENARIO_NAME = "scenario.toml"
@@ -244,8 +245,8 @@ def completed_manifest(member: Member) -> dict | None:
     That is: ``scenario.toml`` reads as the member's, and ``run.json`` says ``completed`` for
     the scenario that file loads into.
     """
-    from floodsph.manifest import read_manifest
-    from floodsph.scenario import load_scenario
+    from floodsph.run.manifest import read_manifest
+    from floodsph.scenario.reader import load_scenario
 
     manifest = read_manifest(member.folder)
     if manifest is None or manifest.get("status") != "completed":
@@ -289,8 +290,8 @@ class MemberResult:
 
 def run_member(task: MemberTask) -> MemberResult:
     """Run one member in its folder (on a dask worker); a failure is returned, not raised."""
-    from floodsph.run import error_message, run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.run.pipeline import error_message, run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     start = time.monotonic()
     folder = Path(task.folder)

@@ -38,8 +38,8 @@ from floodsph.ensemble.manifest import (
 from floodsph.ensemble.members import MEMBERS_DIR, MemberResult, MemberTask
 from floodsph.ensemble.spec import EnsembleSpec
 from floodsph.errors import InputError
-from floodsph.manifest import now_iso
 from floodsph.output.grid import OutputGrid
+from floodsph.run.manifest import now_iso
 
 log = logging.getLogger(__name__)
 
@@ -85,7 +85,7 @@ def run_ensemble(spec: EnsembleSpec, out_dir: str | Path | None = None, *,
     from floodsph.ensemble.engine import require_distributed
     from floodsph.ensemble.members import build_members, completed_manifest
     from floodsph.ensemble.sampling import draw_samples
-    from floodsph.scenario import load_scenario
+    from floodsph.scenario.reader import load_scenario
 
     if resume and overwrite:
         raise InputError("--resume keeps the completed members and --overwrite runs them "
@@ -158,8 +158,8 @@ def _check_folder(out: Path, resume: bool, overwrite: bool) -> dict | None:
 def prepare_base(base) -> BaseSetup:
     """The base scenario's inputs: the map grid, DEM mask and memory estimate (checked)."""
     from floodsph.ensemble.aggregate import dem_mask
-    from floodsph.inputs import prepare_inputs
-    from floodsph.memory import check_memory
+    from floodsph.inputs.memory import check_memory
+    from floodsph.inputs.prepare import prepare_inputs
 
     inputs = prepare_inputs(base)
     check_memory(inputs.memory, base.path.name)
@@ -179,7 +179,7 @@ def _run_members(to_run, out: Path, manifest, results, setup: BaseSetup, schedul
         run_tasks,
     )
     from floodsph.ensemble.members import write_member
-    from floodsph.memory import available_memory
+    from floodsph.inputs.memory import available_memory
 
     for member in to_run:
         write_member(member)

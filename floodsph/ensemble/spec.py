@@ -37,7 +37,7 @@ from pathlib import Path
 from floodsph.ensemble.distributions import OPTIONAL, PARAMETERS, Distribution, read_distribution
 from floodsph.ensemble.keys import KeyPath, KeyPathError
 from floodsph.errors import InputError
-from floodsph.scenario_schema import Reader, describe, is_number, join
+from floodsph.scenario.schema import Reader, describe, is_number, join
 
 ENSEMBLE_KEYS = ("name", "base", "members", "sampling", "seed", "parameters", "output")
 OUTPUT_KEYS = ("depth_thresholds_m", "quantiles")

@@ -1,4 +1,4 @@
-"""Read a DEM file into the solver's :class:`~floodsph.terrain.Terrain`.
+"""Read a DEM file into the solver's :class:`~floodsph.model.terrain.Terrain`.
 
 Steps (each failure is one :class:`~floodsph.errors.InputError` naming the file):
 
@@ -36,7 +36,7 @@ from floodsph.checks.roughness import N_DEFAULT
 from floodsph.errors import InputError, warn
 from floodsph.io.manning import manning_grid
 from floodsph.io.raster import Grid, GridHeader, read_grid
-from floodsph.terrain import Terrain
+from floodsph.model.terrain import Terrain
 
 log = logging.getLogger(__name__)
 
@@ -45,7 +45,7 @@ FILL_HOLES_MAX_CELLS = 100
 
 MIN_CELLS = 3
 """Fewest rows and columns of a DEM: the bed slopes and curvatures are second-order
-differences over three cells (``floodsph.terrain``)."""
+differences over three cells (``floodsph.model.terrain``)."""
 
 
 def load_terrain(

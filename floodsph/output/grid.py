@@ -1,6 +1,6 @@
 """The output map grid: the DEM grid, or a coarser/finer grid aligned to the DEM origin.
 
-Maps are held south-up like :class:`floodsph.terrain.Terrain` (row 0 = southern row; cell
+Maps are held south-up like :class:`floodsph.model.terrain.Terrain` (row 0 = southern row; cell
 (i, j) centred at local ``x = (j + 0.5) dx, y = (i + 0.5) dy``). The local origin is the
 lower-left corner of the DEM, at world coordinates ``(x0, y0)``. Writers flip the rows to
 north-up and use :meth:`OutputGrid.north_up_transform`.

@@ -220,7 +220,7 @@ def nice_levels(top: float) -> np.ndarray:
 CATEGORIES = ("dry in both", "hit (wet in both)", "false alarm (model only)",
               "miss (reference only)")
 CATEGORY_COLOURS = ("#f0f0f0", "#2b8cbe", "#e34a33", "#fdbb84")
-"""Agreement categories 1-4 of :class:`floodsph.compare.Comparison` and their colours."""
+"""Agreement categories 1-4 of :class:`floodsph.output.compare.Comparison` and their colours."""
 
 
 def comparison_figure(result):

@@ -1,7 +1,7 @@
 """Bilinear sampling of the terrain grids (bed, slope, curvature, Manning n) at particles.
 
 The grids are node-centred (node (i, j) at x = (j + 0.5) dx, y = (i + 0.5) dy, row 0 south;
-see ``floodsph.terrain``). Bilinear interpolation reproduces any field that is linear in x and
+see ``floodsph.model.terrain``). Bilinear interpolation reproduces any field that is linear in x and
 y within a cell, so the gradient of a paraboloid (linear) and its Hessian (constant) are
 sampled exactly; points beyond the outermost nodes take the value on the border (clamped).
 

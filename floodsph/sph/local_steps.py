@@ -95,7 +95,8 @@ def kick(rows, stride, half_dt, u, v, ax, ay):
 def close_steps(rows, stride, dt_fine, u, v, ax, ay, rho, manning, d_floor):
     """End the own steps of the particles ``rows``: the half kick v += (s_i dt_f / 2) a_i, then
     implicit Manning friction over s_i dt_f (:func:`floodsph.sph.forces.friction_factor`;
-    n <= 0 means no friction), as steps 5 of ``floodsph.model`` with each particle's own step."""
+    n <= 0 means no friction), as steps 5 of ``floodsph.model.flood_model`` with each particle's
+    own step."""
     for k in prange(rows.shape[0]):
         i = rows[k]
         dt = stride[i] * dt_fine

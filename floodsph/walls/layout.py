@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from floodsph.boundaries.open_edges import SIDES
-from floodsph.terrain import Terrain
+from floodsph.model.terrain import Terrain
 from floodsph.walls.geometry import segments_from_polylines
 from floodsph.walls.junctions import split_at_junctions
 from floodsph.walls.nodata import nodata_polylines

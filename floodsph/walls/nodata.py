@@ -17,7 +17,7 @@ few long segments:
    nearest valid elevation the DEM reader gives nodata cells (``floodsph.io.dem``), and
    initial water fills them (:func:`walled_slivers`).
 
-Coordinates are local metres with row 0 south, as in ``floodsph.terrain``.
+Coordinates are local metres with row 0 south, as in ``floodsph.model.terrain``.
 """
 
 from __future__ import annotations
@@ -243,7 +243,8 @@ def walled_slivers(valid: np.ndarray, dx: float, dy: float,
     the staircase, so the slivers it encloses are nodata cells among the 8 around a valid
     cell. Such a cell is inside when the line from its centre to the centre of the nearest
     valid cell meets no wall (the test :func:`settle_seeds` applies to a seed). Initial water
-    seeded there too (``floodsph.initial``) reaches the walls, as the mirror images assume:
+    seeded there too (``floodsph.inputs.initial_water``) reaches the walls, as the mirror images
+    assume:
     between 30-degree nodata borders a 2 m lake at 5 m spacing had its 5th-percentile depth at
     1.62 m at t = 0 without the slivers and 1.97 m with them.
     """

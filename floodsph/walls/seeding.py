@@ -1,7 +1,7 @@
 """Seeds of still water next to walls: settled, and their masses matched to the seeded depth.
 
 Water is seeded on a square lattice of spacing dx with m_i = rho_w d_i dx^2
-(``floodsph.initial``). In a full kernel support the SPH depth of such a lattice is the
+(``floodsph.inputs.initial_water``). In a full kernel support the SPH depth of such a lattice is the
 seeded d, and still water is an equilibrium (method notes 1.4). Next to a wall the mirror
 images (``floodsph.walls``) complete the support exactly only where the lattice rows run
 along the wall, half a spacing from it. Along an oblique wall (a nodata chord, a user's

@@ -15,16 +15,16 @@ import numpy as np
 import pytest
 from sph_cases import lattice, particles_with_depth, run_until
 
-from floodsph import testing as exact
 from floodsph.boundaries import Inflow, Sink
 from floodsph.boundaries.inflow import lattice_alpha_ratio
 from floodsph.boundaries.riemann import critical_depth, inflow_state
 from floodsph.constants import GRAVITY
 from floodsph.errors import InputError
-from floodsph.hydrograph import Hydrograph
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
-from floodsph.terrain import Terrain
+from floodsph.inputs.hydrograph import Hydrograph
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics
+from floodsph.verification.cases import exact
 from floodsph.walls.openings import cut_openings
 
 G = GRAVITY

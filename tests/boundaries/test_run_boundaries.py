@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from conftest import CELL, NX, NY, X0, Y0
 
-from floodsph.hydrograph import read_hydrograph
-from floodsph.run import run_scenario
-from floodsph.scenario import load_scenario
+from floodsph.inputs.hydrograph import read_hydrograph
+from floodsph.run.pipeline import run_scenario
+from floodsph.scenario.reader import load_scenario
 
 HEAD = f"""\
 [scenario]

@@ -13,9 +13,9 @@ import pytest
 from floodsph.ensemble import aggregate as agg
 from floodsph.ensemble.engine import plan_workers
 from floodsph.errors import InputError
+from floodsph.model.terrain import Terrain
 from floodsph.output.geotiff import write_geotiff
 from floodsph.output.grid import OutputGrid
-from floodsph.terrain import Terrain
 
 NX, NY, MEMBERS = 6, 4, 5
 THRESHOLDS = (0.1, 0.5)

@@ -15,7 +15,7 @@ from floodsph.ensemble.members import build_members, completed_manifest, write_m
 from floodsph.ensemble.sampling import draw_samples
 from floodsph.ensemble.spec import load_ensemble
 from floodsph.errors import InputError
-from floodsph.scenario import load_scenario
+from floodsph.scenario.reader import load_scenario
 
 RASTER_FACTOR = """
 [[ensemble.parameters]]

@@ -7,7 +7,7 @@ from rasterio.transform import from_origin
 
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
-from floodsph.initial import (
+from floodsph.inputs.initial_water import (
     depth_from_level,
     depth_from_raster,
     lattice_depth,
@@ -15,7 +15,7 @@ from floodsph.initial import (
     seed_particles,
 )
 from floodsph.io.polygons import points_in_polygon
-from floodsph.terrain import Terrain
+from floodsph.model.terrain import Terrain
 
 CELL = 10.0
 LEVEL = 20.0
@@ -157,7 +157,7 @@ def test_negative_depth_raster_refused(tmp_path):
 def test_thin_shore_cells_give_their_water_to_the_deepest_neighbour():
     """A steep shore (0.03 and 0.5 m beside 4-6 m) is lumped inwards, the volume kept; a
     uniformly thin sheet and a gentle shore are left alone."""
-    from floodsph.initial import LUMP_RATIO
+    from floodsph.inputs.initial_water import LUMP_RATIO
 
     steep = np.array([[0.0, 0.0, 0.0, 0.0], [0.0, 0.03, 0.5, 5.0], [0.0, 0.02, 4.0, 6.0]])
     lumped = lump_thin_cells(steep)

@@ -12,8 +12,8 @@ import pytest
 from conftest import BASE_SCENARIO, CELL, CRS, NX, NY, RESERVOIR_VOLUME_M3, X0, Y0
 
 from floodsph.errors import InputError
-from floodsph.inputs import prepare_inputs
-from floodsph.scenario import load_scenario, write_resolved
+from floodsph.inputs.prepare import prepare_inputs
+from floodsph.scenario.reader import load_scenario, write_resolved
 
 TO_LONLAT = pyproj.Transformer.from_crs(CRS, "EPSG:4326", always_xy=True)
 

@@ -22,8 +22,8 @@ from conftest import CELL, NY, X0, Y0, valley_elevation, write_geotiff
 from rasterio.crs import CRS
 
 from floodsph.output.envelopes import MAPS
-from floodsph.run import run_scenario
-from floodsph.scenario import load_scenario
+from floodsph.run.pipeline import run_scenario
+from floodsph.scenario.reader import load_scenario
 
 END_S, SNAPSHOT_S, WET_M, DAM_M = 6.0, 2.0, 0.02, 200.0
 DAM_BREAK = f"""

@@ -11,8 +11,8 @@ from rasterio.crs import CRS
 from rasterio.transform import from_origin
 
 from floodsph.cli.compare import command
-from floodsph.compare import compare, scores
 from floodsph.errors import InputError
+from floodsph.output.compare import compare, scores
 
 CELL = 10.0
 WEST, NORTH = 500000.0, 4200000.0

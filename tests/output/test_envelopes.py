@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from floodsph.constants import RHO_WATER
+from floodsph.model.terrain import Terrain
 from floodsph.output.envelopes import MAPS, Envelopes
 from floodsph.output.grid import OutputGrid
-from floodsph.terrain import Terrain
 
 
 def uniform_state(d, u):

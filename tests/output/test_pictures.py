@@ -12,6 +12,7 @@ from rasterio.transform import from_origin
 
 pytest.importorskip("matplotlib", reason="matplotlib (floodsph[plot]) not installed")
 
+from floodsph.model.terrain import Terrain  # noqa: E402
 from floodsph.output.envelopes import Envelopes  # noqa: E402
 from floodsph.output.grid import OutputGrid  # noqa: E402
 from floodsph.output.pictures import (  # noqa: E402
@@ -20,7 +21,6 @@ from floodsph.output.pictures import (  # noqa: E402
     scale_length,
     time_unit,
 )
-from floodsph.terrain import Terrain  # noqa: E402
 
 X0, Y0, CELL = 431000.0, 5012000.0, 5.0
 
@@ -66,8 +66,8 @@ def test_hazard_class_names_do_not_overlap_each_other_or_the_map(envelopes):
 
 
 def test_comparison_legend_stays_clear_of_both_panels():
-    from floodsph.compare import Comparison
-    from floodsph.map_source import Raster
+    from floodsph.output.compare import Comparison
+    from floodsph.output.map_source import Raster
 
     categories = np.zeros((40, 60), dtype=np.uint8)
     categories[:, :] = 1

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from floodsph.constants import RHO_WATER
+from floodsph.model.terrain import Terrain
 from floodsph.output.grid import OutputGrid
 from floodsph.output.rasterise import interpolate, rasterise
 from floodsph.sph.kernels import w_cubic
-from floodsph.terrain import Terrain
 
 KAPPA = 1.3
 

@@ -12,14 +12,14 @@ from rasterio.transform import from_origin
 
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
+from floodsph.model.terrain import Terrain
 from floodsph.output import write_maps
 from floodsph.output.envelopes import MAPS, Envelopes
 from floodsph.output.gauges import Gauges, read_gauge_file
 from floodsph.output.geotiff import write_geotiff
 from floodsph.output.grid import OutputGrid
 from floodsph.output.netcdf import SnapshotWriter, write_flood_maps
-from floodsph.run_folder import PICTURE_NAMES
-from floodsph.terrain import Terrain
+from floodsph.run.folder import PICTURE_NAMES
 
 X0, Y0, CELL = 431000.0, 5012000.0, 5.0
 CRS_UTM = CRS.from_epsg(32632)

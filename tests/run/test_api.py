@@ -36,7 +36,8 @@ def test_import_loads_nothing_heavy():
 
 
 def test_public_names():
-    from floodsph.scenario import Scenario, load_scenario
+    from floodsph.scenario.config import Scenario
+    from floodsph.scenario.reader import load_scenario
 
     assert floodsph.load_scenario is load_scenario and floodsph.Scenario is Scenario
     assert {"load_scenario", "run_scenario", "Scenario", "RunResult", "open_run",

@@ -21,9 +21,9 @@ import xarray as xr
 from run_cases import write_dam_break
 
 from floodsph.output.envelopes import MAPS
-from floodsph.run import run_scenario
-from floodsph.scenario import load_scenario
-from floodsph.schedules import IterationInterval
+from floodsph.run.pipeline import run_scenario
+from floodsph.scenario.reader import load_scenario
+from floodsph.simulation.schedules import IterationInterval
 
 
 def sigterm_at(step: int | None):

@@ -14,7 +14,7 @@ from conftest import BASE_SCENARIO, NX, NY, RESERVOIR_VOLUME_M3, X0, Y0, write_g
 
 from floodsph._version import __version__
 from floodsph.cli.main import cli
-from floodsph.schedules import IterationInterval
+from floodsph.simulation.schedules import IterationInterval
 
 INFLOW = """
 [[inflows]]
@@ -162,7 +162,7 @@ def test_debug_shows_the_exception(tmp_path):
 
 
 def test_check_reports_what_seeding_gives(scenario_file):
-    from floodsph.initial import depth_from_level, seed_particles
+    from floodsph.inputs.initial_water import depth_from_level, seed_particles
     from floodsph.io.dem import load_terrain
 
     terrain = load_terrain(scenario_file.parent / "dem.tif", manning=0.03)
@@ -274,8 +274,8 @@ polyline = [[{X0 + 100.0}, {Y0 - 10.0}], [{X0 + 250.0}, {Y0 + 210.0}]]
      (RuntimeError("boom"), "failed", "RuntimeError: boom")],
 )
 def test_run_json_records_how_the_run_ended(scenario_file, tmp_path, exc, status, error):
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     out = tmp_path / "run"
     with pytest.raises(type(exc)):

@@ -10,12 +10,12 @@ import os
 import subprocess
 import sys
 
-from floodsph.compile_notice import START_MESSAGE
+from floodsph.run.compile_notice import START_MESSAGE
 
 KERNELS = """
 from numba import njit
 
-from floodsph.compile_notice import CompileNotice
+from floodsph.run.compile_notice import CompileNotice
 
 
 @njit(cache=True)

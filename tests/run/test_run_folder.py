@@ -23,9 +23,9 @@ from click.testing import CliRunner
 from conftest import BASE_SCENARIO
 
 from floodsph.cli.main import cli
-from floodsph.run import run_scenario
-from floodsph.scenario import load_scenario
-from floodsph.schedules import IterationInterval
+from floodsph.run.pipeline import run_scenario
+from floodsph.scenario.reader import load_scenario
+from floodsph.simulation.schedules import IterationInterval
 
 
 def invoke(*args):

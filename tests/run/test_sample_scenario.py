@@ -61,8 +61,8 @@ def sample_run(tmp_path_factory):
 
 def test_check_prints_one_particle_per_wet_cell():
     """One particle per reservoir cell at the DEM spacing, less the thin shore cells lumped
-    into deeper neighbours (``floodsph.initial.lump_thin_cells``)."""
-    from floodsph.initial import lump_thin_cells
+    into deeper neighbours (``floodsph.inputs.initial_water.lump_thin_cells``)."""
+    from floodsph.inputs.initial_water import lump_thin_cells
 
     bed, wet, level = _reservoir()
     depth = np.where(wet, level - bed, 0.0)[::-1]  # row 0 = south, as the terrain's grid

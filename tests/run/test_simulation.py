@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from floodsph.particles import ParticleSet
-from floodsph.schedules import IterationInterval, TimeInterval, WallTimeInterval
-from floodsph.simulation import Simulation, SimulationError
+from floodsph.model.particles import ParticleSet
+from floodsph.simulation.loop import Simulation, SimulationError
+from floodsph.simulation.schedules import IterationInterval, TimeInterval, WallTimeInterval
 
 
 class StubModel:

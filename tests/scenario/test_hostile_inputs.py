@@ -475,8 +475,8 @@ def test_unusable_scenario_name_is_refused(valley_dem, tmp_path, command, name, 
 
 
 def prepared(scenario_path: Path):
-    from floodsph.inputs import prepare_inputs
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.scenario.reader import load_scenario
 
     return prepare_inputs(load_scenario(scenario_path))
 
@@ -540,7 +540,7 @@ def test_bom_gauge_file_reads_the_same_points(valley_dem, tmp_path):
 
 
 def test_bom_manning_table_and_hydrograph_read_the_same_values(tmp_path):
-    from floodsph.hydrograph import read_hydrograph
+    from floodsph.inputs.hydrograph import read_hydrograph
     from floodsph.io.manning import read_manning_table
 
     table = "class,name,manning_n\n10,forêt,0.12\n30,prairie,0.035\n"
@@ -598,9 +598,9 @@ polygon = [[{X0 + 200.0}, {Y0}], [{X1}, {Y0}], [{X1}, {Y1}]]
 def test_memory_is_estimated_from_the_dem_header_before_reading(valley_dem, scenario_file):
     """A 100 000 x 100 000 cell DEM file (sparse, a few MB): the estimate of its grids, the
     seeding lattice and the map grids follows the documented formula from the header alone."""
-    from floodsph.inputs import estimate_before_reading
-    from floodsph.memory import BASE_BYTES
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.memory import BASE_BYTES
+    from floodsph.inputs.prepare import estimate_before_reading
+    from floodsph.scenario.reader import load_scenario
 
     sparse_dem(valley_dem.parent, 100_000)
     assert valley_dem.stat().st_size < 50e6

@@ -1,4 +1,5 @@
-"""``floodsph.numerics.Numerics``: one set of solver settings from the scenario's [numerics]
+"""``floodsph.scenario.numerics.Numerics``: one set of solver settings from the scenario's
+[numerics]
 to the model, with the scenario-format.md keys as its field names."""
 
 from __future__ import annotations
@@ -7,8 +8,8 @@ import pytest
 from conftest import BASE_SCENARIO
 
 from floodsph.errors import InputError
-from floodsph.numerics import SCENARIO_KEYS, Numerics, NumericsError, Stabilisation
-from floodsph.scenario import load_scenario
+from floodsph.scenario.numerics import SCENARIO_KEYS, Numerics, NumericsError, Stabilisation
+from floodsph.scenario.reader import load_scenario
 
 CONTRACT_KEYS = {"particle_spacing_m", "cfl", "refinement", "threads"}
 """The [numerics] keys of scenario-format.md's example."""
@@ -37,8 +38,8 @@ def test_the_resolved_scenario_writes_every_numerics_key_given_or_defaulted_and_
 
 def test_the_scenarios_values_reach_the_model_under_their_own_names(write_scenario):
     """What the user writes is what the solver uses: no second set of defaults on the way."""
-    from floodsph.inputs import prepare_inputs
-    from floodsph.run import build_model
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.run.pipeline import build_model
     from floodsph.sph import forces
 
     text = BASE_SCENARIO.replace(
@@ -54,8 +55,8 @@ def test_the_scenarios_values_reach_the_model_under_their_own_names(write_scenar
 
 
 def test_the_dem_cell_size_fills_in_a_missing_particle_spacing(write_scenario):
-    from floodsph.inputs import prepare_inputs
-    from floodsph.run import build_model
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.run.pipeline import build_model
 
     scenario = load_scenario(write_scenario(BASE_SCENARIO.replace(
         "particle_spacing_m = 10.0\n", "")))
@@ -74,8 +75,8 @@ def test_the_dem_cell_size_fills_in_a_missing_particle_spacing(write_scenario):
         ({"h_ratio": 0.5}, "numerics.h_ratio: must be >= 1, got 0.5"),
         ({"particle_spacing_m": 0.0}, "numerics.particle_spacing_m: must be > 0, got 0"),
         ({"stabilisation": "riemann"}, "numerics.stabilisation: expected a "
-                                       "floodsph.numerics.Stabilisation ('lax-friedrichs', "
-                                       "'riemann'), got 'riemann'"),
+                                       "floodsph.scenario.numerics.Stabilisation "
+                                       "('lax-friedrichs', 'riemann'), got 'riemann'"),
     ],
 )
 def test_numerics_built_in_code_are_checked_as_a_scenario_is(settings, message):

@@ -9,13 +9,10 @@ import pytest
 from conftest import BASE_SCENARIO, X0, Y0
 
 from floodsph.errors import InputError
-from floodsph.numerics import Refinement
-from floodsph.scenario import (
-    Edges,
-    OutputFormat,
-    load_scenario,
-    write_resolved,
-)
+from floodsph.scenario.config import Edges, OutputFormat
+from floodsph.scenario.numerics import Refinement
+from floodsph.scenario.reader import load_scenario
+from floodsph.scenario.writer import write_resolved
 
 MINIMAL = """\
 [scenario]
@@ -197,7 +194,7 @@ def test_a_bad_hydrograph_is_refused_with_the_inputs_naming_file_key_and_line(wr
                                                                               tmp_path):
     """The scenario checks that the CSV exists; the inputs read it, once, before any run
     folder is touched."""
-    from floodsph.inputs import prepare_inputs
+    from floodsph.inputs.prepare import prepare_inputs
 
     (tmp_path / "q.csv").write_text("time_s,discharge_m3s\n0,0\n10,5\n5,1\n")
     text = BASE_SCENARIO + f"[[inflows]]\nline = [[{X0}, {Y0}], [{X0}, {Y0 + 50}]]\n" \
@@ -212,8 +209,8 @@ def test_a_bad_hydrograph_is_refused_with_the_inputs_naming_file_key_and_line(wr
 
 
 def test_refinement_thresholds_reach_the_refiner(write_scenario):
-    from floodsph.inputs import prepare_inputs
-    from floodsph.run import build_model
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.run.pipeline import build_model
 
     text = BASE_SCENARIO.replace(
         'refinement = "none"',
@@ -231,8 +228,8 @@ def test_refinement_thresholds_reach_the_refiner(write_scenario):
 
 def test_closed_sides_are_walls_and_the_other_sides_open(write_scenario):
     from floodsph.boundaries import OpenEdges
-    from floodsph.inputs import prepare_inputs
-    from floodsph.run import build_model
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.run.pipeline import build_model
 
     text = BASE_SCENARIO.replace('edges = "closed"', 'edges = "open"\nclosed_sides = ["west"]')
     scenario = load_scenario(write_scenario(text))
@@ -253,7 +250,7 @@ def test_worldcover_manning_table_from_toml(write_scenario, tmp_path):
     import numpy as np
     from conftest import NX, NY, write_geotiff
 
-    from floodsph.inputs import prepare_inputs
+    from floodsph.inputs.prepare import prepare_inputs
 
     classes = np.where(np.arange(NX)[None, :] < NX // 2, 10, 40) * np.ones((NY, 1))
     write_geotiff(tmp_path / "landcover.tif", classes, nodata=0)

@@ -2,8 +2,9 @@
 defaults a run really uses, and is what ``workflows/scenario_reference.py`` writes now.
 
 The keys the parser accepts are found by asking the parser itself: each table is given an
-unknown key, and the refusal lists the allowed ones. So a key added to ``floodsph/scenario.py``
-without its entry in ``floodsph/scenario_keys.py`` (and a re-generated page) fails here."""
+unknown key, and the refusal lists the allowed ones. So a key added to
+``floodsph/scenario/config.py``
+without its entry in ``floodsph/scenario/keys.py`` (and a re-generated page) fails here."""
 
 from __future__ import annotations
 
@@ -15,8 +16,8 @@ import pytest
 from conftest import load_workflow
 
 from floodsph.errors import InputError
-from floodsph.scenario import scenario_from_dict
-from floodsph.scenario_keys import TABLES
+from floodsph.scenario.keys import TABLES
+from floodsph.scenario.reader import scenario_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "scenario-reference.md"
@@ -87,14 +88,14 @@ def test_every_key_the_parser_accepts_is_on_the_page(parser_keys):
     missing = sorted(f"{t}.{k}" for t, keys in parser_keys.items() for k in keys
                      if k not in listed.get(t, {}))
     assert not missing, (f"accepted by the parser but not in docs/scenario-reference.md: "
-                         f"{missing}; add a KeyDoc to floodsph/scenario_keys.py and {REGENERATE}")
+                         f"{missing}; add a KeyDoc to floodsph/scenario/keys.py and {REGENERATE}")
 
 
 def test_every_key_on_the_page_is_accepted_by_the_parser(parser_keys):
     documented = {t.name: {k.name for k in t.keys} for t in TABLES}
     extra = sorted(f"{t}.{k}" for t, keys in documented.items() for k in keys
                    if k not in parser_keys.get(t, set()))
-    assert not extra, f"documented in floodsph/scenario_keys.py but refused by the parser: {extra}"
+    assert not extra, f"documented in floodsph/scenario/keys.py but refused by the parser: {extra}"
 
 
 def test_the_page_shows_the_defaults_a_loaded_scenario_gets(tmp_path):

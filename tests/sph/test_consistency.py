@@ -3,10 +3,10 @@
 import numpy as np
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
-from floodsph.particles import ParticleSet
-from floodsph.terrain import Terrain
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.particles import ParticleSet
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics
 
 
 def stretched_lake(stretch, slope, dx=10.0, kappa=Numerics.kappa, patch=None):

@@ -5,7 +5,7 @@ import pytest
 from sph_cases import model_on
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.numerics import TimeStepping
+from floodsph.scenario.numerics import TimeStepping
 from floodsph.sph import forces
 
 N, D = 0.05, 0.2  # Manning n [s m-1/3], depth [m]

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 from sph_cases import model_on, particles_with_depth, run_until
 
-from floodsph import verification as cases
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics, Refinement, TimeStepping
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics, Refinement, TimeStepping
 from floodsph.sph import local_steps
 from floodsph.sph.neighbours import NeighbourList
-from floodsph.terrain import Terrain
+from floodsph.verification.cases import cases
 
 
 def test_strides_are_the_largest_powers_of_two_within_each_particles_own_cfl_step():
@@ -99,6 +99,6 @@ def test_local_steps_conserve_momentum_to_the_order_of_the_step():
 
 def test_numerics_reject_a_time_stepping_that_is_no_time_stepping():
     with pytest.raises(ValueError, match=r"numerics.time_stepping: expected a "
-                                         r"floodsph.numerics.TimeStepping \('global', "
+                                         r"floodsph.scenario.numerics.TimeStepping \('global', "
                                          r"'local'\), got 'local'"):
         Numerics(time_stepping="local")  # the string, not TimeStepping.LOCAL

@@ -1,4 +1,4 @@
-"""Particle splitting and coalescing (floodsph.refinement, floodsph.sph.refine).
+"""Particle splitting and coalescing (floodsph.model.refinement, floodsph.sph.refine).
 
 Facts checked: every split and every merge conserves mass and momentum to round-off; the
 depth field survives a split and a merge; the merged smoothing length satisfies its kernel
@@ -10,16 +10,16 @@ import math
 import numpy as np
 import pytest
 
-from floodsph import verification as cases
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
-from floodsph.model import FloodModel
-from floodsph.numerics import SMOOTHING_EXCESS, Numerics, NumericsError, Refinement
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.refinement import Refiner
+from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
-from floodsph.refinement import Refiner
+from floodsph.scenario.numerics import SMOOTHING_EXCESS, Numerics, NumericsError, Refinement
 from floodsph.sph import refine
 from floodsph.sph.kernels import SIGMA_2D, w_cubic
-from floodsph.terrain import Terrain
+from floodsph.verification.cases import cases
 from tests.sph_cases import lattice, model_on, particles_with_depth
 
 
@@ -75,7 +75,8 @@ def test_settings_reject_thresholds_without_hysteresis():
                                          r"refine_area_max / 2 = 1 .*got 1\.5"):
         Numerics(refine_area_max=2.0, refine_area_min=1.5)
     with pytest.raises(NumericsError, match=r"numerics.refinement: expected a "
-                                            r"floodsph.numerics.Refinement .*got 'coarsen'"):
+                                            r"floodsph.scenario.numerics.Refinement "
+                                            r".*got 'coarsen'"):
         Numerics(refinement="coarsen")
     assert Refiner.of(Numerics(particle_spacing_m=10.0, refinement=Refinement.NONE)) is None
     r = Refiner.of(Numerics(particle_spacing_m=10.0, refinement=Refinement.SPLIT))
@@ -404,7 +405,7 @@ def test_refined_dam_break_matches_the_fine_uniform_run_at_a_third_of_the_cost()
 
 
 def test_split_daughters_relax_to_sqrt3_lattice_smoothing_and_lattice_particles_stay():
-    from floodsph.refinement import RELAX_RATE, relax_smoothing
+    from floodsph.model.refinement import RELAX_RATE, relax_smoothing
 
     model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
     p = model.particles

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from sph_cases import lattice, model_on, particles_with_depth
 
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics
 from floodsph.sph import density
-from floodsph.terrain import Terrain
 
 
 def solve(model, **kwargs):

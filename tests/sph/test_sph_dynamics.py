@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from sph_cases import model_on, particles_with_depth, run_until
 
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
-from floodsph.terrain import Terrain
+from floodsph.scenario.numerics import Numerics
 
 
 def test_closed_box_conserves_mass_and_keeps_every_particle_inside():

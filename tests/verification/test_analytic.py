@@ -1,4 +1,5 @@
-"""The exact shallow-water solutions in floodsph.testing satisfy the equations they claim to.
+"""The exact shallow-water solutions in floodsph.verification.exact satisfy the equations they
+claim to.
 
 Each solution is checked against the physics independently of its own formulas: finite
 differences of the returned fields must satisfy the shallow-water equations, integrals must
@@ -12,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from floodsph.testing import (
+from floodsph.verification.exact import (
     front_position,
     l1_relative,
     lake_at_rest,

@@ -7,9 +7,8 @@ are marked slow (``pytest -m slow``).
 import numpy as np
 import pytest
 
-from floodsph import testing as exact
-from floodsph import verification as cases
-from floodsph.numerics import Refinement
+from floodsph.scenario.numerics import Refinement
+from floodsph.verification.cases import cases, exact
 
 
 def test_ritter_dam_break_coarse():

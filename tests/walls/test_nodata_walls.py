@@ -5,10 +5,10 @@ import pytest
 from scipy import ndimage
 
 from floodsph.constants import RHO_WATER
-from floodsph.initial import seed_particles, wet_cells
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
-from floodsph.terrain import Terrain
+from floodsph.inputs.initial_water import seed_particles, wet_cells
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics
 from floodsph.walls import nodata as nw
 from floodsph.walls.geometry import segments_from_polylines
 from floodsph.walls.openings import cut_openings

@@ -9,8 +9,8 @@ from conftest import load_workflow
 from sph_cases import lattice, model_on, run_until
 
 from floodsph.constants import RHO_WATER
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics
+from floodsph.model.flood_model import FloodModel
+from floodsph.scenario.numerics import Numerics
 from floodsph.walls import seeding as wall_seeding
 from floodsph.walls.geometry import segments_from_polylines
 from floodsph.walls.index import WallIndex

@@ -94,7 +94,7 @@ def test_anuga_map_is_written_on_the_dem_grid_north_up(tmp_path):
     import rasterio
     from rasterio.crs import CRS
 
-    from floodsph.terrain import Terrain
+    from floodsph.model.terrain import Terrain
 
     crs = CRS.from_epsg(32632)
     terrain = Terrain(elevation=np.zeros((3, 4)), dx=10.0, dy=5.0, x0=500000.0, y0=4000000.0,
@@ -135,8 +135,8 @@ def test_walls_along_a_whole_side_around_an_inflow_make_it_reflective():
 
 
 def test_walls_off_the_border_are_refused_naming_the_table(write_scenario):
-    from floodsph.inputs import prepare_inputs
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.scenario.reader import load_scenario
 
     text = BASE_SCENARIO + f"\n[[walls]]\npolyline = [[{X0 + 50}, {Y0}], [{X0 + 50}, {Y0 + 90}]]\n"
     scenario = load_scenario(write_scenario(text))
@@ -220,8 +220,8 @@ def test_dry_gauge_samples_count_as_zero_depth(tmp_path):
 @needs_ea4
 def test_ea4_scenario_and_hydrograph_written_to_the_contract(tmp_path):
     from floodsph.cli.main import cli
-    from floodsph.hydrograph import read_hydrograph
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.hydrograph import read_hydrograph
+    from floodsph.scenario.reader import load_scenario
 
     path = ea4.write_inputs(EA4_DATA, tmp_path, 18000.0, 10, 10.0)
     hydrograph = read_hydrograph(tmp_path / "ea4_hydrograph.csv")

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from conftest import load_workflow
 
-from floodsph.numerics import Numerics
+from floodsph.scenario.numerics import Numerics
 
 lattice = load_workflow("lattice_stability",
                         Path(__file__).resolve().parents[2] / "workflows" / "lattice_stability.py")

@@ -74,7 +74,7 @@ mode = "overtopping"
 
 
 def test_breach_variants_scale_froehlich_width_and_time(tmp_path, write_scenario):
-    from floodsph.scenario import load_scenario
+    from floodsph.scenario.reader import load_scenario
 
     base = study.base_data(write_scenario(BREACH_SCENARIO))
     variants = study.make_variants(base, tmp_path / "inputs", manning_factors=(0.8,),
@@ -104,7 +104,7 @@ def test_breach_variants_scale_froehlich_width_and_time(tmp_path, write_scenario
 def test_manning_raster_variant_is_the_raster_scaled(tmp_path, write_scenario):
     import rasterio
 
-    from floodsph.scenario import load_scenario
+    from floodsph.scenario.reader import load_scenario
 
     n = np.full((NY, NX), 0.03)
     n[:, NX // 2:] = 0.06
@@ -193,9 +193,9 @@ def test_malpasset_points_read_back(tmp_path):
 def test_malpasset_sea_modes_differ_by_the_cells_below_sea_level(tmp_path):
     import rasterio
 
-    from floodsph.inputs import prepare_inputs
+    from floodsph.inputs.prepare import prepare_inputs
     from floodsph.io.polygons import points_in_polygon
-    from floodsph.scenario import load_scenario
+    from floodsph.scenario.reader import load_scenario
     from floodsph.walls.nodata import walled_slivers
 
     inputs = {}
@@ -205,12 +205,14 @@ def test_malpasset_sea_modes_differ_by_the_cells_below_sea_level(tmp_path):
     with rasterio.open(DATA / mp_setup.DEM_NAME) as src:
         bed = src.read(1, masked=True)
         transform = src.transform
-    # Particles are seeded where the depth exceeds 1 mm (floodsph.initial.seed_particles).
+    # Particles are seeded where the depth exceeds 1 mm
+    # (floodsph.inputs.initial_water.seed_particles).
     sea_cells = int(((bed < -1e-3) & ~bed.mask).sum())
     sea_volume = float((-bed[bed < 0]).sum()) * 20.0 * 20.0
     with_sea, sink = inputs["particles"][1], inputs["sink"][1]
     # The sea also fills the nodata slivers inside the simplified offshore walls
-    # (floodsph.initial.wet_cells), at the nearest valid elevation; nowhere else is nodata wet.
+    # (floodsph.inputs.initial_water.wet_cells), at the nearest valid elevation; nowhere else is
+    # nodata wet.
     terrain = with_sea.terrain
     sliver = walled_slivers(terrain.valid, terrain.dx, terrain.dy)
     extra = with_sea.depth - sink.depth

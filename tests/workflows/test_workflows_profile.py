@@ -9,8 +9,8 @@ import pytest
 from conftest import load_workflow
 from sph_cases import model_on
 
-from floodsph.numerics import Numerics
-from floodsph.refinement import Refiner
+from floodsph.model.refinement import Refiner
+from floodsph.scenario.numerics import Numerics
 
 REPO = Path(__file__).resolve().parents[2]
 prof = load_workflow("profile_stages", REPO / "workflows" / "profile_stages.py")

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 from conftest import load_workflow
 
-from floodsph.stage_timer import STAGES, StageTimer
+from floodsph.model.stage_timer import STAGES, StageTimer
 
 REPO = Path(__file__).resolve().parents[2]
 step_cost = load_workflow("step_cost", REPO / "workflows" / "step_cost.py")

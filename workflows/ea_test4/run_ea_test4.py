@@ -37,8 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
-from floodsph.numerics import Refinement
 from floodsph.output.tables import write_csv
+from floodsph.scenario.numerics import Refinement
 
 REPO = Path(__file__).resolve().parents[2]
 DEM_NAMES = {5: "ea4_dem_5m.asc", 10: "ea4_dem_10m.asc"}
@@ -86,7 +86,7 @@ def write_inputs(folder: Path, out: Path, end_time: float, dem_cell: int,
     ``numerics.refinement`` (None: floodsph's default)."""
     from tomli_w import dumps
 
-    from floodsph.hydrograph import read_hydrograph, write_hydrograph_csv
+    from floodsph.inputs.hydrograph import read_hydrograph, write_hydrograph_csv
 
     hydrograph = read_hydrograph(folder / HYDROGRAPH_NAME, "EA test 4 hydrograph")
     write_hydrograph_csv(out / "ea4_hydrograph.csv", hydrograph.t, hydrograph.Q)
@@ -257,9 +257,9 @@ def main(argv=None) -> int:
               "ea_test4/ (or place it in <repo>/../shared/benchmarks); nothing run.",
               file=sys.stderr)
         return 0
-    from floodsph.hydrograph import read_hydrograph
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
+    from floodsph.inputs.hydrograph import read_hydrograph
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
 
     out = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)

@@ -48,9 +48,9 @@ def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_T
                 threads: int | None = None, refinement: str | None = None,
                 time_stepping: str | None = None) -> dict:
     """Write, run and report one sea mode in ``out/<sea>/``; returns its cost row."""
-    from floodsph.run import run_scenario
-    from floodsph.scenario import load_scenario
-    from floodsph.schedules import TimeInterval
+    from floodsph.run.pipeline import run_scenario
+    from floodsph.scenario.reader import load_scenario
+    from floodsph.simulation.schedules import TimeInterval
 
     where = out / sea
     path = setup.write_scenario(folder, where, sea, end_time, spacing, gauge_interval,
@@ -82,7 +82,7 @@ def summarise(out: Path) -> tuple[list[dict], list[dict]]:
     """
     import csv
 
-    from floodsph.manifest import read_manifest
+    from floodsph.run.manifest import read_manifest
 
     points, costs, curves = [], [], {}
     for sea in setup.SEA_MODES:

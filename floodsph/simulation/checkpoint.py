@@ -29,9 +29,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from floodsph._version import __version__
-from floodsph.atomic_files import atomic_path
 from floodsph.errors import InputError
-from floodsph.run_folder import CHECKPOINT_DIR
+from floodsph.run.atomic_files import atomic_path
+from floodsph.run.folder import CHECKPOINT_DIR
 
 STATE_NAME = "state.pkl"
 FORMAT = 1

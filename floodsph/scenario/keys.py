@@ -1,6 +1,6 @@
 """What each key of the scenario file means: type, units, default and meaning, as named data.
 
-The parser (``floodsph.scenario``) decides which keys are accepted and checks their values;
+The parser (``floodsph.scenario.config``) decides which keys are accepted and checks their values;
 this module says what they are for. ``docs/scenario-reference.md`` is generated from
 :data:`TABLES` by ``python workflows/scenario_reference.py``, and
 ``tests/scenario/test_scenario_reference.py`` fails when a key the parser accepts has no
@@ -22,8 +22,7 @@ from dataclasses import MISSING, dataclass, fields
 from enum import Enum
 
 from floodsph.breach.params import BreachParams
-from floodsph.numerics import Numerics, Refinement, Stabilisation, TimeStepping, WallModel
-from floodsph.scenario import (
+from floodsph.scenario.config import (
     SIDES,
     Edges,
     Gauges,
@@ -36,6 +35,7 @@ from floodsph.scenario import (
     TerrainConfig,
     Wall,
 )
+from floodsph.scenario.numerics import Numerics, Refinement, Stabilisation, TimeStepping, WallModel
 
 POINTS = "array of [x, y]"
 """The type of a list of points in the DEM's CRS."""

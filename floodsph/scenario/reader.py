@@ -1,272 +1,44 @@
-"""The scenario: one TOML file, read into frozen, validated dataclasses.
+"""Reading a scenario TOML file into the validated dataclasses of ``floodsph.scenario.config``.
 
 ``load_scenario(path)`` parses the file (stdlib ``tomllib``), rejects unknown keys, wrong types
 and impossible values with one message naming the file and the key path, resolves relative
 paths against the scenario file's folder and fills the defaults of the contract
-(``docs``: ``scenario-format.md``). Nothing else in floodsph reads the TOML; everything reads
-the :class:`Scenario`.
-
-Coordinates stay in the DEM's CRS here; they are shifted to the terrain's local origin only
-when the model is built (``floodsph.run``).
+(``docs/scenario-reference.md``). Nothing else in floodsph reads the TOML; everything reads
+the :class:`~floodsph.scenario.config.Scenario`.
 """
 
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from floodsph.checks.elevation import ELEVATION_LIMIT_M
-from floodsph.checks.roughness import N_DEFAULT, N_STRICKLER, strickler_text
+from floodsph.checks.roughness import N_STRICKLER, strickler_text
 from floodsph.errors import InputError
-from floodsph.numerics import SCENARIO_KEYS as NUMERICS_KEYS
-from floodsph.numerics import Numerics, NumericsError
-from floodsph.scenario_schema import Reader, describe, join
+from floodsph.scenario.config import (
+    SIDES,
+    TOP_KEYS,
+    Edges,
+    Gauges,
+    Inflow,
+    InitialWater,
+    OutputConfig,
+    OutputFormat,
+    Scenario,
+    ScenarioInfo,
+    Sink,
+    TerrainConfig,
+    Wall,
+)
+from floodsph.scenario.numerics import SCENARIO_KEYS as NUMERICS_KEYS
+from floodsph.scenario.numerics import Numerics, NumericsError
+from floodsph.scenario.schema import Reader, describe, join
 
 if TYPE_CHECKING:
     from floodsph.breach.params import BreachParams
-
-Point = tuple[float, float]
-
-
-class Edges(Enum):
-    """What happens at the DEM border: water leaves (``open``) or is reflected (``closed``)."""
-
-    OPEN = "open"
-    CLOSED = "closed"
-
-
-class OutputFormat(Enum):
-    """Map file formats written at the end of a run."""
-
-    GEOTIFF = "geotiff"
-    NETCDF = "netcdf"
-
-
-@dataclass(frozen=True)
-class ScenarioInfo:
-    """``[scenario]``: the name (also the default output folder) and the simulated time [s]."""
-
-    name: str
-    end_time_s: float
-    description: str = ""
-
-
-@dataclass(frozen=True)
-class TerrainConfig:
-    """``[terrain]``: the DEM and the bed roughness (a uniform n, an n raster or land cover).
-
-    ``manning`` is None when the roughness comes from ``landcover`` (+ ``manning_table``: a
-    CSV path, or ``"worldcover"`` for the shipped ESA WorldCover table).
-    """
-
-    dem: Path
-    crs: str | None = None
-    dem_variable: str | None = None
-    manning: float | Path | None = N_DEFAULT
-    landcover: Path | None = None
-    manning_table: Path | str | None = None
-    extent: tuple[float, float, float, float] | None = None
-    edges: Edges = Edges.OPEN
-    closed_sides: tuple[str, ...] = ()
-
-    @property
-    def nodata_walled(self) -> bool:
-        """True when the DEM's nodata border is a wall: edges closed, or any side kept closed
-        (``floodsph.model.FloodModel`` walls nodata unless every edge is open)."""
-        return self.edges is Edges.CLOSED or bool(self.closed_sides)
-
-
-@dataclass(frozen=True)
-class InitialWater:
-    """``[[initial_water]]``: a free-surface level inside a polygon, or a depth raster.
-
-    The polygons may come from a vector ``file`` (+ ``layer``, ``crs``) instead of
-    ``polygon`` (``floodsph.io.vector``); ``feature`` names the feature of such a file a
-    body was read from (``floodsph.vector_inputs``).
-    """
-
-    level_m: float | None = None
-    polygon: tuple[Point, ...] | None = None
-    depth: Path | None = None
-    file: Path | None = None
-    layer: str | None = None
-    crs: str | None = None
-    feature: str | None = None
-
-
-@dataclass(frozen=True)
-class Wall:
-    """``[[walls]]``: a polyline water cannot cross (closed: a solid footprint), or the lines
-    and polygon outlines of a vector ``file`` (+ ``layer``, ``crs``; see InitialWater)."""
-
-    polyline: tuple[Point, ...] | None = None
-    file: Path | None = None
-    layer: str | None = None
-    crs: str | None = None
-    feature: str | None = None
-
-    @property
-    def closed(self) -> bool:
-        return self.polyline[0] == self.polyline[-1]
-
-
-@dataclass(frozen=True)
-class Inflow:
-    """``[[inflows]]``: a breach section with a discharge hydrograph Q(t) [m3/s].
-
-    ``hydrograph`` is the CSV of Q(t) (read by ``floodsph.inputs``, as every file the scenario
-    names); ``breach`` the validated ``[inflows.breach]`` table of a parametric breach
-    (``floodsph.breach.params.BreachParams``, file paths absolute), routed into Q(t) there.
-
-    ``direction`` (optional) is the flow direction [dx, dy]; by default water enters normal
-    to ``line`` towards lower ground.
-    """
-
-    line: tuple[Point, Point]
-    hydrograph: Path | None = None
-    breach: BreachParams | None = None
-    direction: Point | None = None
-
-
-@dataclass(frozen=True)
-class Sink:
-    """``[[sinks]]``: a polygon where water leaves the model (counted as outflow), or the
-    polygons of a vector ``file`` (+ ``layer``, ``crs``; see InitialWater)."""
-
-    polygon: tuple[Point, ...] | None = None
-    file: Path | None = None
-    layer: str | None = None
-    crs: str | None = None
-    feature: str | None = None
-
-
-@dataclass(frozen=True)
-class Gauges:
-    """``[gauges]``: a CSV of points (id, x, y), or a vector file of points (+ ``layer``,
-    ``crs``, and ``id_field``, the attribute naming each gauge), sampled every
-    ``interval_s`` seconds."""
-
-    file: Path
-    interval_s: float = 10.0
-    layer: str | None = None
-    crs: str | None = None
-    id_field: str | None = None
-
-
-@dataclass(frozen=True)
-class OutputConfig:
-    """``[output]``: where and what to write. ``directory = None`` means ``out/<name>``.
-
-    ``checkpoint_interval_s`` [s of simulated time] > 0 writes a checkpoint at the first step
-    at or after each multiple of it (``floodsph.checkpoint``); 0 writes none on a schedule
-    (a stop signal still writes one).
-    """
-
-    directory: Path | None = None
-    resolution_m: float | None = None
-    wet_threshold_m: float = 0.01
-    formats: tuple[OutputFormat, ...] = (OutputFormat.GEOTIFF, OutputFormat.NETCDF)
-    snapshot_interval_s: float = 0.0
-    mass_balance_interval_s: float = 10.0
-    checkpoint_interval_s: float = 0.0
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """One validated scenario; ``path`` is the (absolute) scenario file it came from."""
-
-    path: Path
-    scenario: ScenarioInfo
-    terrain: TerrainConfig
-    initial_water: tuple[InitialWater, ...] = ()
-    walls: tuple[Wall, ...] = ()
-    inflows: tuple[Inflow, ...] = ()
-    sinks: tuple[Sink, ...] = ()
-    gauges: Gauges | None = None
-    numerics: Numerics = Numerics()
-    output: OutputConfig = OutputConfig()
-
-    @property
-    def name(self) -> str:
-        return self.scenario.name
-
-    @property
-    def end_time_s(self) -> float:
-        return self.scenario.end_time_s
-
-    @property
-    def output_directory(self) -> Path:
-        """The run folder: ``output.directory`` or ``<scenario folder>/out/<name>``."""
-        if self.output.directory is not None:
-            return self.output.directory
-        return self.path.parent / "out" / self.name
-
-    def input_files(self) -> tuple[Path, ...]:
-        """The scenario file and every file it reads (a run never writes over them)."""
-        t = self.terrain
-        files = [self.path, t.dem, t.landcover,
-                 t.manning_table if isinstance(t.manning_table, Path) else None,
-                 t.manning if isinstance(t.manning, Path) else None,
-                 *(w.depth for w in self.initial_water),
-                 *(entry.file for entry in (*self.initial_water, *self.walls, *self.sinks)),
-                 *(i.hydrograph for i in self.inflows),
-                 None if self.gauges is None else self.gauges.file]
-        return tuple(f for f in files if f is not None)
-
-    def to_dict(self) -> dict:
-        """The resolved scenario as plain JSON/TOML-able data (paths absolute, defaults filled).
-
-        ``None`` values are left out, so the result reloads into an equal :class:`Scenario`.
-        """
-        out = {f.name: _plain(getattr(self, f.name)) for f in fields(self) if f.name != "path"}
-        out["output"]["directory"] = str(self.output_directory)
-        return {k: v for k, v in out.items() if v is not None and v != []}
-
-    def __repr__(self) -> str:
-        return (
-            f"Scenario({self.name!r}, end_time_s={self.end_time_s:g}, "
-            f"dem={self.terrain.dem.name!r}, "
-            f"initial_water={len(self.initial_water)}, walls={len(self.walls)}, "
-            f"inflows={len(self.inflows)}, sinks={len(self.sinks)})"
-        )
-
-
-def _plain(value):
-    """Dataclasses, enums, paths and tuples to dicts, strings and lists; drops ``None`` and the
-    fields that are no scenario keys (``metadata["scenario"]`` False)."""
-    if hasattr(value, "__dataclass_fields__"):
-        items = ((f.name, _plain(getattr(value, f.name))) for f in fields(value)
-                 if f.metadata.get("scenario", True))
-        return {k: v for k, v in items if v is not None}
-    if isinstance(value, Enum):
-        return value.value
-    if isinstance(value, Path):
-        return str(value)
-    if isinstance(value, tuple | list):
-        return [_plain(v) for v in value]
-    if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
-    return value
-
-
-# ---------------------------------------------------------------------------------------------
-# Loading and validation
-# ---------------------------------------------------------------------------------------------
-
-TOP_KEYS = (
-    "scenario",
-    "terrain",
-    "initial_water",
-    "walls",
-    "inflows",
-    "sinks",
-    "gauges",
-    "numerics",
-    "output",
-)
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -415,7 +187,6 @@ def _manning_table(r: Reader, t: dict, p: str) -> Path | str | None:
     return r.existing_file(t, p, "manning_table", None)
 
 
-SIDES = ("west", "east", "south", "north")
 
 
 def _closed_sides(r: Reader, t: dict, p: str, edges: Edges) -> tuple[str, ...]:
@@ -485,7 +256,7 @@ def _inflow(r: Reader, t: dict, p: str) -> Inflow:
 
 def _breach(r: Reader, value, where: str) -> BreachParams:
     """``[inflows.breach]`` validated by the breach module, its files made absolute and
-    checked to exist (they are read when the breach is routed, ``floodsph.inputs``)."""
+    checked to exist (they are read when the breach is routed, ``floodsph.inputs.prepare``)."""
     from dataclasses import replace
 
     from floodsph.breach.params import BreachParams
@@ -531,7 +302,8 @@ def _gauges(r: Reader, data: dict) -> Gauges | None:
 
 
 def _numerics(r: Reader, data: dict) -> Numerics:
-    """``[numerics]`` straight into :class:`~floodsph.numerics.Numerics`: each key read as the
+    """``[numerics]`` straight into :class:`~floodsph.scenario.numerics.Numerics`: each key read as
+    the
     type of its field, then checked by ``Numerics`` itself (bounds, the refinement rule)."""
     p = "numerics"
     t = r.sub_table(data, "", p, NUMERICS_KEYS)
@@ -579,14 +351,3 @@ def _output(r: Reader, data: dict) -> OutputConfig:
         checkpoint_interval_s=r.number(t, p, "checkpoint_interval_s",
                                        d.checkpoint_interval_s, ge=0.0),
     )
-
-
-def write_resolved(scenario: Scenario, path: Path) -> None:
-    """Write the resolved scenario (absolute paths, defaults filled) as TOML to ``path``."""
-    from tomli_w import dumps
-
-    header = (
-        f"# Resolved copy of {scenario.path}\n"
-        "# (absolute paths and every default filled in; loads back into the same scenario)\n\n"
-    )
-    Path(path).write_text(header + dumps(scenario.to_dict()), encoding="utf-8")

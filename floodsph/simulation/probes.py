@@ -1,7 +1,7 @@
 """Run-time callbacks: the mass-balance table, the progress bar and the progress log.
 
-Each is a callable taking the :class:`~floodsph.simulation.Simulation`; the run pairs it with
-a schedule (``floodsph.run``).
+Each is a callable taking the :class:`~floodsph.simulation.loop.Simulation`; the run pairs it with
+a schedule (``floodsph.run.pipeline``).
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ import numpy as np
 
 from floodsph.errors import InputError
 from floodsph.io.text import read_csv_rows
-from floodsph.scenario_schema import LARGEST_VALUE
+from floodsph.scenario.schema import LARGEST_VALUE
 
 TIME_COLUMN = "time_s"
 DISCHARGE_COLUMN = "discharge_m3s"

@@ -1,6 +1,6 @@
 """Typed readers for the scenario TOML: every check names the file and the key path.
 
-The scenario loader (``floodsph.scenario``) reads each table through these helpers so that
+The scenario loader (``floodsph.scenario.config``) reads each table through these helpers so that
 every problem is reported the same way, before any work starts::
 
     scenario.toml: inflows[0].line: expected two [x, y] points, got 1

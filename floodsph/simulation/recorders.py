@@ -1,7 +1,7 @@
 """The run's output recorders as simulation callbacks: map envelopes, gauges, snapshots.
 
 :class:`Recorders` owns the objects of ``floodsph.output`` for one run, hands their
-``(callback, schedule)`` pairs to the :class:`~floodsph.simulation.Simulation`, and writes the
+``(callback, schedule)`` pairs to the :class:`~floodsph.simulation.loop.Simulation`, and writes the
 final files (:meth:`Recorders.write`) only when the run completes, so a failed or interrupted
 run never leaves maps that look finished. Snapshots are appended as the run goes to
 ``snapshots.nc.part``, moved to ``snapshots.nc`` by :meth:`Recorders.write`.
@@ -14,9 +14,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from floodsph.run_folder import GAUGES_NAME, SNAPSHOTS_NAME
-from floodsph.scenario import Scenario
-from floodsph.schedules import TimeInterval
+from floodsph.run.folder import GAUGES_NAME, SNAPSHOTS_NAME
+from floodsph.scenario.config import Scenario
+from floodsph.simulation.schedules import TimeInterval
 
 SNAPSHOTS_PART = SNAPSHOTS_NAME + ".part"
 

@@ -9,7 +9,7 @@ the bookkeeping. Total mass and linear momentum are unchanged to round-off by ev
 and every merge.
 
 Criteria (thresholds are multiples of the initial particle area A0 = spacing^2; each name
-below is a ``refine_*`` field of ``floodsph.numerics.Numerics``: area_max stands for
+below is a ``refine_*`` field of ``floodsph.scenario.numerics.Numerics``: area_max stands for
 ``refine_area_max``, d_min for ``refine_d_min_m``, and so on):
 
 * split p when A_p > area_max A0, d_p >= d_min, level_p < max_level, and all seven daughters
@@ -62,7 +62,7 @@ import numpy as np
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.errors import InputError
-from floodsph.numerics import SMOOTHING_EXCESS, Numerics
+from floodsph.scenario.numerics import SMOOTHING_EXCESS, Numerics
 
 HEXAGON_MARGIN = 1.01
 """Radius, relative to a parent's hexagon, within which wall segments are tested against the

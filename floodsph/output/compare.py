@@ -1,7 +1,7 @@
 """Compare two flood maps: binary wet/dry skill scores, depth errors, arrival-time errors.
 
 ``compare(model, reference)`` reads each map as one band (a raster file, or a NetCDF variable
-``flood_maps.nc:max_depth``: :mod:`floodsph.map_source`), reprojects the REFERENCE map onto
+``flood_maps.nc:max_depth``: :mod:`floodsph.output.map_source`), reprojects the REFERENCE map onto
 the MODEL map's grid (``rasterio.warp.reproject``: bilinear for depth and arrival time,
 nearest for class maps) and evaluates only the cells the reference map covers. A cell is wet
 when its depth is above the threshold (class maps: class > 0); NaN/nodata counts as dry.
@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from floodsph.errors import InputError
-from floodsph.map_source import Raster, read_raster
+from floodsph.output.map_source import Raster, read_raster
 
 
 def align(model: Raster, ref: Raster) -> tuple[np.ndarray, np.ndarray]:

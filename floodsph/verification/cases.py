@@ -1,7 +1,7 @@
 """Analytic verification cases run through the real solver path (terrain, particles, model).
 
 Each case builds a ``FloodModel`` on an analytic bed with ``Terrain.from_function``, runs it
-and returns the error against the exact solution of ``floodsph.testing``, with the cost
+and returns the error against the exact solution of ``floodsph.verification.exact``, with the cost
 counters a speed-against-error study needs and the depth profile at the end time. Used by the
 slow tests, ``workflows/speed_vs_error.py`` and ``workflows/validation_pages.py``.
 
@@ -23,12 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from floodsph import testing as exact
-from floodsph.initial import particles_at
-from floodsph.model import FloodModel
-from floodsph.numerics import Numerics, Refinement
+from floodsph.inputs.initial_water import particles_at
+from floodsph.model.flood_model import FloodModel
+from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
-from floodsph.terrain import Terrain
+from floodsph.scenario.numerics import Numerics, Refinement
+from floodsph.verification.cases import exact
 
 
 @dataclass(frozen=True)
@@ -106,7 +106,7 @@ def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **nume
     """A FloodModel on an analytic bed with particles on a lattice of spacing dx where the
     depth exceeds 1 mm; ``numerics``: fields of its ``Numerics`` (``refinement`` default
     ``Refinement.NONE``: uniform resolution; another mode adds a refiner)."""
-    from floodsph.refinement import Refiner
+    from floodsph.model.refinement import Refiner
 
     terrain = Terrain.from_function(bed, xlim, ylim, cell)
     X, Y = np.meshgrid(np.arange(dx / 2, terrain.width, dx), np.arange(dx / 2, terrain.height, dx))

@@ -2,8 +2,9 @@
 
 A field of :class:`Numerics` is named as its key in the scenario file (``scenario-format.md``):
 ``particle_spacing_m`` in the TOML is ``numerics.particle_spacing_m`` in the model. Its default
-and its bounds are written here once; ``floodsph.scenario`` reads the table straight into it,
-``floodsph.model.FloodModel`` and ``floodsph.refinement.Refiner`` read it. A few fields are
+and its bounds are written here once; ``floodsph.scenario.config`` reads the table straight into it,
+``floodsph.model.flood_model.FloodModel`` and ``floodsph.model.refinement.Refiner`` read it. A few
+fields are
 not scenario keys (``metadata["scenario"]`` False): the solver's inner tunables, set by tests
 and studies only; they are neither read from nor written to scenario files.
 """
@@ -86,9 +87,10 @@ class Numerics:
     Scenario keys (``[numerics]``):
 
     particle_spacing_m : initial particle spacing [m]; None (the scenario's default) means the
-        DEM cell size, which ``floodsph.run.build_model`` fills in: the model needs a number.
+        DEM cell size, which ``floodsph.run.pipeline.build_model`` fills in: the model needs a
+        number.
     cfl : Courant number of dt = cfl min h / (|v| + c).
-    refinement : splitting and coalescing of particles (``floodsph.refinement``).
+    refinement : splitting and coalescing of particles (``floodsph.model.refinement``).
     threads : numba threads of a run; 0 means all cores.
     kappa : h0 / particle spacing. 1.2 (SWE-SPHysics' suggested value, method notes 1.4): on
         the square lattice the water is seeded on, still water is then a minimum of the SPH
@@ -120,7 +122,7 @@ class Numerics:
     refine_depth_jump : no merge when |d_a - d_b| > refine_depth_jump max(d_a, d_b).
     refine_speed_jump : no merge when |v_a - v_b| > refine_speed_jump sqrt(g max(d_a, d_b)).
     refine_smoothing_excess : split particles relax to h^2 rho = refine_smoothing_excess
-        kappa^2 m (``floodsph.refinement.relax_smoothing``; 1 is the lattice value).
+        kappa^2 m (``floodsph.model.refinement.relax_smoothing``; 1 is the lattice value).
     """
 
     particle_spacing_m: float | None = _setting(None, float, gt=0.0, optional=True)

@@ -21,7 +21,8 @@ Bytes, at the larger of the two peaks (seeding, then the run)::
   any crop or resampling: the DEM and the largest of the Manning, land-cover and depth
   rasters);
 * SEEDING = cells_lattice * SEEDING_ARRAYS * 8: the initial water is seeded on a dense
-  lattice of the particle spacing over the whole DEM (``floodsph.initial``): the lattice
+  lattice of the particle spacing over the whole DEM (``floodsph.inputs.initial_water``): the
+  lattice
   depths, their padded copy, the 8 shifted neighbour grids stacked, the deepest neighbour
   and the masks. ``tracemalloc`` measured a peak of 12.3-13.0 float64 per lattice cell
   (lattices of 1.6e5 and 6.4e5 cells, 1 % wet); 14 errs high;
@@ -34,7 +35,7 @@ Bytes, at the larger of the two peaks (seeding, then the run)::
   (153 MiB resident on the project machine, 183 MiB with floodsph imported: VmRSS) plus
   compiled kernels.
 
-Every count comes from shapes and areas known before the arrays exist (``floodsph.inputs``
+Every count comes from shapes and areas known before the arrays exist (``floodsph.inputs.prepare``
 estimates before reading the DEM, and again before seeding), so a run too large is refused
 before it is allocated. Counts are clamped at ``COUNT_LIMIT``: a spacing of 1e-300 m gives an
 estimate that is merely enormous, not an overflow.

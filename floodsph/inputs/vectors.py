@@ -1,4 +1,4 @@
-"""Scenario geometry from vector files, placed on the DEM (``floodsph.inputs``).
+"""Scenario geometry from vector files, placed on the DEM (``floodsph.inputs.prepare``).
 
 An entry with ``file`` (``[[walls]]``, ``[[initial_water]]``, ``[[sinks]]``) becomes one entry
 per part of each feature, with its coordinates in the DEM's CRS, checked as inline ones

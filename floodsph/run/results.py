@@ -15,8 +15,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from floodsph.errors import InputError
-from floodsph.manifest import MANIFEST_NAME, read_manifest
-from floodsph.run_folder import MAP_NAMES
+from floodsph.run.folder import MAP_NAMES
+from floodsph.run.manifest import MANIFEST_NAME, read_manifest
 
 NETCDF_MAPS = "flood_maps.nc"
 GEOTIFF_MAPS = tuple(name for name in MAP_NAMES if name.endswith(".tif"))

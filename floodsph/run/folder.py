@@ -15,7 +15,7 @@ Rules (``docs/run-folder.md``, the run-folder contract):
   ``.floodsph.lock``); the operating system releases it when the process ends, however it
   ends, so a killed run never leaves a stale lock.
 * Every file goes in under a temporary name and is renamed into place
-  (``floodsph.atomic_files``); files are readable by the group, as the user's umask allows.
+  (``floodsph.run.atomic_files``); files are readable by the group, as the user's umask allows.
 """
 
 from __future__ import annotations
@@ -26,9 +26,9 @@ import shutil
 from collections.abc import Iterable
 from pathlib import Path
 
-from floodsph.atomic_files import TEMP_PREFIX
 from floodsph.errors import InputError
-from floodsph.manifest import MANIFEST_NAME, read_manifest
+from floodsph.run.atomic_files import TEMP_PREFIX
+from floodsph.run.manifest import MANIFEST_NAME, read_manifest
 
 LOG_NAME = "floodsph.log"
 RESOLVED_NAME = "scenario.resolved.toml"

@@ -11,7 +11,7 @@ scenario), ``status`` (``"running"`` while the run is under way, then ``"complet
 mean, run anyway), ``checkpoint_time_s`` (the latest checkpoint) and ``resumed_from`` (the
 checkpoint times the run was resumed from).
 
-The file is written atomically (``floodsph.atomic_files``), so a reader never sees half a
+The file is written atomically (``floodsph.run.atomic_files``), so a reader never sees half a
 manifest.
 """
 
@@ -24,7 +24,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from floodsph._version import __version__
-from floodsph.atomic_files import atomic_path
+from floodsph.run.atomic_files import atomic_path
 
 MANIFEST_NAME = "run.json"
 

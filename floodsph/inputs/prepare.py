@@ -5,11 +5,11 @@ created (``floodsph check`` stops after it and prints :func:`summary_lines`):
 
 1. read or route the inflow hydrographs and integrate them up to the end time;
 2. read the DEM's header and refuse a run too large for the memory available, from the grid
-   shapes alone (``floodsph.memory``), before any grid is allocated;
+   shapes alone (``floodsph.inputs.memory``), before any grid is allocated;
 3. load the DEM and roughness (``floodsph.io.dem.load_terrain``: fill values, feet, Manning
    values that are Strickler coefficients);
 4. read the geometry given as vector files, reprojected into the DEM's CRS
-   (``floodsph.vector_inputs``), and check that all of it lies on the DEM
+   (``floodsph.inputs.vectors``), and check that all of it lies on the DEM
    (``floodsph.checks.placement``);
 5. build the initial depth grid: the deepest of all ``[[initial_water]]`` bodies per cell
    (two overlapping still-water bodies hold the higher level, not the sum); refuse a
@@ -34,11 +34,11 @@ import numpy as np
 from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
+from floodsph.inputs.memory import MemoryEstimate, check_memory, estimate_memory, format_bytes
+from floodsph.inputs.vectors import vector_gauges, with_vector_geometry
 from floodsph.io.raster import crs_label
 from floodsph.io.vector import is_vector_file
-from floodsph.memory import MemoryEstimate, check_memory, estimate_memory, format_bytes
-from floodsph.scenario import Scenario
-from floodsph.vector_inputs import vector_gauges, with_vector_geometry
+from floodsph.scenario.config import Scenario
 
 
 @dataclass
@@ -68,7 +68,7 @@ class Inputs:
 def prepare_inputs(scenario: Scenario) -> Inputs:
     """Load and check everything a run needs; raises ``InputError`` on bad input, including a
     run whose memory estimate exceeds the memory available (before allocating it)."""
-    from floodsph.initial import seed_particles, wet_cells
+    from floodsph.inputs.initial_water import seed_particles, wet_cells
     from floodsph.io.dem import load_terrain
 
     tc = scenario.terrain
@@ -153,7 +153,8 @@ def output_cells(scenario: Scenario, shape: tuple[int, int], dx: float, dy: floa
 
 
 def lattice_cells(width: float, height: float, spacing: float) -> float:
-    """Cells of the seeding lattice of ``spacing`` over a DEM (``floodsph.initial``), a float
+    """Cells of the seeding lattice of ``spacing`` over a DEM (``floodsph.inputs.initial_water``),
+    a float
     as :func:`output_cells`."""
     nx, ny = np.floor(width / spacing + 1e-9), np.floor(height / spacing + 1e-9)
     with np.errstate(over="ignore"):
@@ -206,12 +207,12 @@ def estimate_before_reading(scenario: Scenario, volume_inflow_m3: float,
 def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None = None
                   ) -> np.ndarray:
     """Depth grid [m] (row 0 = south) of all initial water bodies: the cell-wise maximum,
-    on the cells ``wet`` (default: the valid ones; ``floodsph.initial.wet_cells``).
+    on the cells ``wet`` (default: the valid ones; ``floodsph.inputs.initial_water.wet_cells``).
 
     ``dry``, when a list, receives why each body that holds no water holds none
     (:func:`floodsph.checks.water.dry_body_reason`).
     """
-    from floodsph.initial import depth_from_level, depth_from_raster
+    from floodsph.inputs.initial_water import depth_from_level, depth_from_raster
 
     source = str(scenario.path.name)
     depth = np.zeros(terrain.shape)
@@ -230,9 +231,9 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
 
 
 def inflow_hydrographs(scenario: Scenario) -> list:
-    """One :class:`~floodsph.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
-    one place it is read), or its breach (validated by ``floodsph.scenario``) routed."""
-    from floodsph.hydrograph import Hydrograph, read_hydrograph
+    """One :class:`~floodsph.inputs.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
+    one place it is read), or its breach (validated by ``floodsph.scenario.config``) routed."""
+    from floodsph.inputs.hydrograph import Hydrograph, read_hydrograph
 
     source = str(scenario.path.name)
     out = []

@@ -31,8 +31,8 @@ from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
 from floodsph.io.polygons import check_polygon, points_in_polygon
 from floodsph.io.raster import read_grid, resample_onto
-from floodsph.particles import ParticleSet
-from floodsph.terrain import Terrain
+from floodsph.model.particles import ParticleSet
+from floodsph.model.terrain import Terrain
 from floodsph.walls.nodata import walled_slivers
 
 LUMP_RATIO = 9.0

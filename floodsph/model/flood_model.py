@@ -1,7 +1,7 @@
 """FloodModel: particles on a terrain, advanced one time step at a time.
 
 The model knows how to take a step and nothing about files, schedules or output (those are
-``floodsph.simulation``'s). One step (kick-drift-kick leap-frog with a variable CFL step,
+``floodsph.simulation.loop``'s). One step (kick-drift-kick leap-frog with a variable CFL step,
 method notes 2.6-2.7):
 
 1. kick   v^{n+1/2} = v^n + a^n dt / 2
@@ -28,12 +28,12 @@ import numpy as np
 from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
 from floodsph.boundaries.open_edges import OpenEdges
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.numerics import Numerics, Stabilisation, TimeStepping, WallModel
-from floodsph.particles import ParticleSet
+from floodsph.model.particles import ParticleSet
+from floodsph.model.terrain import Terrain
+from floodsph.scenario.numerics import Numerics, Stabilisation, TimeStepping, WallModel
 from floodsph.sph import bed as bedmod
 from floodsph.sph import consistency, density, forces, local_steps, shore
 from floodsph.sph.neighbours import CellGrid, NeighbourList
-from floodsph.terrain import Terrain
 from floodsph.walls import seeding as wall_seeding
 from floodsph.walls import shadow, sight
 from floodsph.walls.index import WallIndex
@@ -59,7 +59,7 @@ class FloodModel:
         (``floodsph.walls.seeding``): the set is changed in place, and
         ``volume_seed_adjustment`` [m3] is the volume change.
     numerics : Numerics
-        The solver's settings (``floodsph.numerics``), with ``particle_spacing_m`` given.
+        The solver's settings (``floodsph.scenario.numerics``), with ``particle_spacing_m`` given.
     walls : sequence of (k, 2) arrays
         Polylines in local coordinates that water cannot cross.
     closed_edges : bool or collection of str
@@ -75,12 +75,12 @@ class FloodModel:
         ``opening``.
     refiner : object or None
         Particle splitting and coalescing: ``apply(model) -> (splits, merges)``, called after
-        the boundaries once the particles have moved (``floodsph.refinement``).
+        the boundaries once the particles have moved (``floodsph.model.refinement``).
 
     Attributes
     ----------
     stage_timer : StageTimer or None
-        Set it to a ``floodsph.stage_timer.StageTimer`` to have every step add the wall time
+        Set it to a ``floodsph.model.stage_timer.StageTimer`` to have every step add the wall time
         of each of its stages there (None, the default: no timing).
     """
 
@@ -91,7 +91,7 @@ class FloodModel:
         if numerics.particle_spacing_m is None:
             raise ValueError("FloodModel: numerics.particle_spacing_m must be given (the "
                              "scenario's default, the DEM cell size, is filled in by "
-                             "floodsph.run.build_model)")
+                             "floodsph.run.pipeline.build_model)")
         self.terrain = terrain
         self.boundaries = list(boundaries)
         self.refiner = refiner

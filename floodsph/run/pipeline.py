@@ -1,6 +1,6 @@
 """``run_scenario``: one scenario from its TOML to a finished run folder.
 
-The chain (architecture.md 3.2): the run folder is checked (``floodsph.run_folder``: nothing
+The chain (architecture.md 3.2): the run folder is checked (``floodsph.run.folder``: nothing
 that is not a floodsph run's, no completed run unless replaced) -> inputs (terrain,
 particles, hydrographs; every input check happens here, before the run folder is touched)
 -> the folder is locked and opened (``floodsph.log``, ``scenario.resolved.toml``,
@@ -9,7 +9,8 @@ particles, hydrographs; every input check happens here, before the run folder is
 gauges and mass balance (written under temporary names, then renamed) -> ``run.json`` last.
 
 ``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached
-before the end time); ``"interrupted"`` (SIGINT, SIGTERM or SIGHUP: ``floodsph.stop_signals``;
+before the end time); ``"interrupted"`` (SIGINT, SIGTERM or SIGHUP:
+``floodsph.simulation.stop_signals``;
 once the time loop runs, a checkpoint is written first and the manifest is returned);
 ``"failed"`` (the exception is re-raised, its one-line message is in ``error``). A run that
 replaces a completed one is built in ``.floodsph-new/`` and swapped in when it completes.
@@ -23,14 +24,15 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from floodsph.atomic_files import TEMP_PREFIX, atomic_path
-from floodsph.atomic_files import umask as _umask
 from floodsph.errors import InputError
-from floodsph.manifest import new_manifest, now_iso, write_manifest
-from floodsph.run_folder import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME, RunFolder
-from floodsph.scenario import Edges, Scenario, write_resolved
-from floodsph.schedules import time_tolerance
-from floodsph.stop_signals import StopSignals
+from floodsph.run.atomic_files import TEMP_PREFIX, atomic_path
+from floodsph.run.atomic_files import umask as _umask
+from floodsph.run.folder import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME, RunFolder
+from floodsph.run.manifest import new_manifest, now_iso, write_manifest
+from floodsph.scenario.config import Edges, Scenario
+from floodsph.scenario.writer import write_resolved
+from floodsph.simulation.schedules import time_tolerance
+from floodsph.simulation.stop_signals import StopSignals
 
 log = logging.getLogger(__name__)
 
@@ -68,7 +70,7 @@ def run_scenario(
     threads : int, optional
         Numba threads; default ``numerics.threads`` (0 = all cores).
     callbacks : sequence of (callable, schedule)
-        Extra callbacks for the :class:`~floodsph.simulation.Simulation`.
+        Extra callbacks for the :class:`~floodsph.simulation.loop.Simulation`.
     resume : bool
         Continue from the latest checkpoint in ``out_dir``; the scenario must equal the
         checkpointed one but for a later ``end_time_s``.
@@ -78,8 +80,8 @@ def run_scenario(
     InputError
         Bad input, a run folder the run may not write, or a run too large for the memory.
     """
-    from floodsph.inputs import prepare_inputs
-    from floodsph.memory import check_memory
+    from floodsph.inputs.memory import check_memory
+    from floodsph.inputs.prepare import prepare_inputs
 
     if overwrite and resume:
         raise InputError("--overwrite and --resume exclude each other: resume continues the "
@@ -112,7 +114,7 @@ class RunOptions:
 
 def _resumable(folder: RunFolder, scenario: Scenario, inputs, threads: int):
     """The checkpoint to resume from, refused unless the scenario is the same."""
-    from floodsph.checkpoint import load_checkpoint, scenario_difference
+    from floodsph.simulation.checkpoint import load_checkpoint, scenario_difference
 
     directory = folder.checkpoint_dir()
     checkpoint = load_checkpoint(directory, inputs.terrain)
@@ -200,7 +202,7 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
 def error_message(exc: BaseException) -> str:
     """The one line a user sees for ``exc``: the message of an input or simulation error,
     the file and reason of an OS error (a full disk, say), else the type and message."""
-    from floodsph.simulation import SimulationError
+    from floodsph.simulation.loop import SimulationError
 
     if isinstance(exc, InputError):
         return str(exc)
@@ -279,8 +281,8 @@ def build_model(scenario: Scenario, inputs):
     """
     from dataclasses import replace
 
-    from floodsph.model import FloodModel
-    from floodsph.refinement import Refiner
+    from floodsph.model.flood_model import FloodModel
+    from floodsph.model.refinement import Refiner
 
     numerics = replace(scenario.numerics, particle_spacing_m=inputs.spacing_m)
     return FloodModel(
@@ -328,7 +330,7 @@ def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]
     The file ``breach_hydrograph_<i>.csv`` (time_s, discharge_m3s) in the run folder is what
     the run used, so it can be checked or reused as a ``hydrograph`` input.
     """
-    from floodsph.hydrograph import write_hydrograph_csv
+    from floodsph.inputs.hydrograph import write_hydrograph_csv
 
     names = []
     for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,
@@ -347,10 +349,10 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
     The checkpoint callback comes last, so that a checkpoint holds what every other callback
     recorded at its step.
     """
-    from floodsph.probes import MassBalance, Progress, log_progress
-    from floodsph.recorders import Recorders
-    from floodsph.schedules import TimeInterval, WallTimeInterval
-    from floodsph.simulation import Simulation
+    from floodsph.simulation.loop import Simulation
+    from floodsph.simulation.probes import MassBalance, Progress, log_progress
+    from floodsph.simulation.recorders import Recorders
+    from floodsph.simulation.schedules import TimeInterval, WallTimeInterval
 
     work = folder.work
     state = None if checkpoint is None else checkpoint.recorders
@@ -383,7 +385,7 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
 
 def _save(sim, scenario, threads, manifest, mass, recorders, work, wall_start) -> Path:
     """Write a checkpoint of the run now; ``manifest`` gets its time."""
-    from floodsph.checkpoint import Checkpoint, save_checkpoint
+    from floodsph.simulation.checkpoint import Checkpoint, save_checkpoint
 
     model = sim.model
     checkpoint = Checkpoint(scenario=scenario.to_dict(), threads=threads, model=model,

@@ -1,0 +1,2 @@
+"""Everything the run reads before the model exists: terrain, roughness, hydrographs, initial
+water, vector layers, the memory estimate."""

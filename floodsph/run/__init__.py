@@ -1,0 +1,1 @@
+"""One run of a scenario: the pipeline, the run folder, run.json, results and the compile notice."""

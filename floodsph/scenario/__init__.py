@@ -1,0 +1,1 @@
+"""The scenario file: its dataclasses, reader, key reference and numerics settings."""

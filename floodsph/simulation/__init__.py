@@ -1,0 +1,1 @@
+"""The time loop: schedules, probes, recorders, checkpoints and stop signals."""

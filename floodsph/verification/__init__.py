@@ -1,0 +1,1 @@
+"""Exact solutions of the analytic cases and the cases that run them through the solver."""
