@@ -40,7 +40,7 @@ def run_scenario(
     floodsph.errors.InputError
         Bad input, a run folder the run may not write, or a run too large for the memory.
     """
-    from floodsph.run.pipeline import pipeline as run
+    from floodsph.run import pipeline as run
 
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)

@@ -22,7 +22,7 @@ THREADS = 2
 
 def _analytic(name: str, dx: float, **options) -> dict:
     """One ``floodsph.verification.cases`` case, with its depth profile along the channel."""
-    from floodsph.verification.cases import cases as verification
+    from floodsph.verification import cases as verification
 
     result = verification.CASES[name](dx, **options)
     return {"particles": result.particles, "steps": result.steps,

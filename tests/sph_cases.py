@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from floodsph.inputs.initial_water import particles_at
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
@@ -35,7 +35,7 @@ def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, ma
         d = np.maximum(level_or_depth - bed(xw, yw), 0.0)
     p = particles_with_depth(x, y, np.asarray(d, dtype=float), dx, kappa)
     num = Numerics(particle_spacing_m=dx, kappa=kappa, **numerics)
-    return FloodModel(terrain, p, num, walls=walls, closed_edges=closed)
+    return set_up_model(terrain, p, num, walls=walls, closed_edges=closed)
 
 
 def run_until(model, t_end):

@@ -45,7 +45,7 @@ import numpy as np
 from numba import njit
 
 from floodsph.inputs.initial_water import seed_particles
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
 from floodsph.sph.kernels import w_cubic
@@ -120,7 +120,7 @@ def still_lake(kappa: float, end_time: float, side: float = 1000.0, spacing: flo
     rng = np.random.default_rng(seed)
     p.x[:p.n] += rng.normal(0.0, perturbation, p.n)
     p.y[:p.n] += rng.normal(0.0, perturbation, p.n)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=spacing, kappa=kappa))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=spacing, kappa=kappa))
     out = []
     for t_end in np.arange(every, end_time + 1e-9, every):
         while model.t < t_end - 1e-9:
@@ -141,7 +141,7 @@ def bowl_lake(end_time: float, every: float = 100.0, spacing: float = 10.0,
     terrain = Terrain.from_function(bowl, (0.0, 1000.0), (0.0, 1000.0), 10.0)
     p = seed_particles(terrain, np.maximum(level - terrain.elevation, 0.0), spacing,
                        Numerics.kappa)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=spacing))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=spacing))
     out = []
     for t_end in np.arange(every, end_time + 1e-9, every):
         while model.t < t_end - 1e-9:

@@ -107,7 +107,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     from floodsph.errors import InputError
     from floodsph.inputs.prepare import prepare_inputs
-    from floodsph.run.pipeline import build_model, set_threads
+    from floodsph.model.from_scenario import build_model
+    from floodsph.run.pipeline import set_threads
     from floodsph.scenario.reader import load_scenario
 
     set_threads(args.threads)

@@ -54,12 +54,13 @@ import run_ea_test4 as ea4  # noqa: E402
 import scenario_runs as runs  # noqa: E402
 
 from floodsph.constants import RHO_WATER  # noqa: E402
+from floodsph.model.builder import set_up_model  # noqa: E402
 from floodsph.model.flood_model import FloodModel  # noqa: E402
 from floodsph.model.particles import ParticleSet  # noqa: E402
 from floodsph.model.terrain import Terrain  # noqa: E402
 from floodsph.output.tables import markdown, write_csv  # noqa: E402
 from floodsph.scenario.numerics import Numerics, Refinement, TimeStepping  # noqa: E402
-from floodsph.verification.cases import cases  # noqa: E402
+from floodsph.verification import cases  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -84,7 +85,7 @@ def block_model(kind: str, n_side: int, dx: float = 5.0, **numerics) -> FloodMod
     p = ParticleSet(X.size)
     p.append(x=X.ravel(), y=Y.ravel(), m=np.full(X.size, RHO_WATER * depth * dx * dx),
              rho=np.full(X.size, RHO_WATER * depth), h=np.full(X.size, Numerics.kappa * dx))
-    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx, **numerics))
+    return set_up_model(terrain, p, Numerics(particle_spacing_m=dx, **numerics))
 
 
 def throughput(kind: str, n_side: int = BLOCK_SIDE, steps: int = 10, repeats: int = 3,

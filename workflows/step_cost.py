@@ -48,7 +48,7 @@ def dam_break(spacing: float):
     public pieces only (``Terrain``, ``ParticleSet``, ``Numerics``), so that any checkout
     builds the same case."""
     from floodsph.constants import RHO_WATER
-    from floodsph.model.flood_model import FloodModel
+    from floodsph.model.builder import set_up_model
     from floodsph.model.particles import ParticleSet
     from floodsph.model.terrain import Terrain
     from floodsph.scenario.numerics import Numerics
@@ -62,7 +62,7 @@ def dam_break(spacing: float):
     p.append(x=x, y=y, m=np.full(x.size, RHO_WATER * DEPTH_M * spacing * spacing),
              rho=np.full(x.size, RHO_WATER * DEPTH_M),
              h=np.full(x.size, numerics.kappa * spacing))
-    return FloodModel(terrain, p, numerics)
+    return set_up_model(terrain, p, numerics)
 
 
 def measure(spacing: float, steps: int, warmup: int) -> dict:

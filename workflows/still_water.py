@@ -234,7 +234,7 @@ def dam_break_figures(run: CaseRun) -> dict:
     """L1 of the mean depth profile against Ritter, of the lines next to the walls and of
     the middle lines, and the front error, at the end time."""
     from floodsph.output.rasterise import interpolate
-    from floodsph.verification.cases import exact
+    from floodsph.verification import exact, metrics
 
     ch = run.case.channel
     p = run.probe.particles
@@ -247,11 +247,11 @@ def dam_break_figures(run: CaseRun) -> dict:
     d = np.nan_to_num(d).reshape(S.shape)
     d_exact, _ = exact.ritter(s, ch.t_end, ch.d0, x_dam=ch.x_dam)
     mean = d.mean(axis=0)
-    front = (exact.front_position(s, mean, FRONT_DEPTH_M)
-             - exact.front_position(s, d_exact, FRONT_DEPTH_M))
-    return {"l1": exact.l1_relative(mean, d_exact),
-            "l1_wall_lines": exact.l1_relative(d[[0, -1]].mean(axis=0), d_exact),
-            "l1_middle_lines": exact.l1_relative(d[[1, 2]].mean(axis=0), d_exact),
+    front = (metrics.front_position(s, mean, FRONT_DEPTH_M)
+             - metrics.front_position(s, d_exact, FRONT_DEPTH_M))
+    return {"l1": metrics.l1_relative(mean, d_exact),
+            "l1_wall_lines": metrics.l1_relative(d[[0, -1]].mean(axis=0), d_exact),
+            "l1_middle_lines": metrics.l1_relative(d[[1, 2]].mean(axis=0), d_exact),
             "front_error_m": float(front),
             "outside": max(smp.outside for smp in run.samples)}
 

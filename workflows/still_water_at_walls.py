@@ -33,11 +33,12 @@ import numpy as np
 from matplotlib.path import Path
 
 from floodsph.constants import RHO_WATER
+from floodsph.model.builder import set_up_model
 from floodsph.model.flood_model import FloodModel
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
-from floodsph.verification.cases import cases as verification
+from floodsph.verification import cases as verification
 from floodsph.walls import seeding as wall_seeding
 
 CASES = ("turned-rectangle", "turned-building", "large-building", "ritter-3.78m")
@@ -64,7 +65,7 @@ def lattice_lake(size, depth, dx, polyline, inside: bool) -> FloodModel:
              rho=np.full(n, RHO_WATER * depth), h=np.full(n, Numerics.kappa * dx))
     cells = (int(round(size[1] / 5.0)), int(round(size[0] / 5.0)))
     terrain = Terrain(np.zeros(cells), 5.0, 5.0, manning=0.0)
-    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx), walls=[polyline])
+    return set_up_model(terrain, p, Numerics(particle_spacing_m=dx), walls=[polyline])
 
 
 def build(case: str) -> tuple[FloodModel, float]:

@@ -30,10 +30,7 @@ import provenance  # noqa: E402
 
 from floodsph.output.tables import markdown  # noqa: E402
 from floodsph.scenario.numerics import Numerics, Refinement  # noqa: E402
-from floodsph.verification.cases import (
-    cases,  # noqa: E402
-    exact,  # noqa: E402
-)
+from floodsph.verification import cases, exact, metrics  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -126,7 +123,7 @@ def order_text(rows: list[cases.CaseResult]) -> str:
     for mode in MODES:
         sel = [r for r in rows if r.refinement == mode.value]
         if len(sel) > 1:
-            p = exact.observed_order([r.l1 for r in sel], [r.spacing for r in sel])
+            p = metrics.observed_order([r.l1 for r in sel], [r.spacing for r in sel])
             parts.append(f"{mode.value} {p:.2f}")
     return ("Observed order of the L1 error in the spacing (least-squares slope of log L1 "
             f"against log dx): {', '.join(parts)}.") if parts else ""

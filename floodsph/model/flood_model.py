@@ -21,24 +21,20 @@ multiple of the finest step (``floodsph.sph.local_steps``).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
-from floodsph.boundaries.open_edges import OpenEdges
-from floodsph.constants import GRAVITY, RHO_WATER
+from floodsph.constants import RHO_WATER
+from floodsph.model.local_stepping import big_step
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics, Stabilisation, TimeStepping, WallModel
 from floodsph.sph import bed as bedmod
-from floodsph.sph import consistency, density, forces, local_steps, shore
-from floodsph.sph.neighbours import CellGrid, NeighbourList
-from floodsph.walls import seeding as wall_seeding
+from floodsph.sph import consistency, density, forces, shore, time_step
+from floodsph.sph.cells import CellGrid
+from floodsph.sph.neighbours import NeighbourList
+from floodsph.sph.sums import SUMS
 from floodsph.walls import shadow, sight
 from floodsph.walls.index import WallIndex
-from floodsph.walls.layout import model_segments
-from floodsph.walls.nodata import settle_seeds
 
 MAX_SEARCH_GROWTH = 2.0
 """Cap on the factor ``hgrow`` by which a particle's neighbour search is widened."""
@@ -49,30 +45,28 @@ SETTLE_ROUNDS = 30
 class FloodModel:
     """Shallow-water SPH particles on a terrain.
 
+    The model steps; it is set up by ``floodsph.model.builder.set_up_model``, which makes the
+    wall segments and the open edges, settles the seeds and solves the first density. Its
+    arguments here are that set-up's results.
+
     Parameters
     ----------
     terrain : Terrain
     particles : ParticleSet
-        Seeded particles (local coordinates) with m, rho = rho_w d and h = kappa dx set; their
-        density and smoothing length are solved on construction. Seeds of still water next to
-        walls are also settled there, and their masses matched to the seeded depth
-        (``floodsph.walls.seeding``): the set is changed in place, and
-        ``volume_seed_adjustment`` [m3] is the volume change.
+        The water particles (local coordinates).
     numerics : Numerics
-        The solver's settings (``floodsph.scenario.numerics``), with ``particle_spacing_m`` given.
-    walls : sequence of (k, 2) arrays
-        Polylines in local coordinates that water cannot cross.
-    closed_edges : bool or collection of str
-        True: the DEM border and nodata areas are walls. False: water reaching them leaves the
-        model and is counted in ``volume_out``; the open sides get transmissive ghosts
-        (``floodsph.boundaries.OpenEdges``). A collection of sides (``"west"``, ``"east"``,
-        ``"south"``, ``"north"``) closes those sides and opens the others; nodata borders
-        are then walls.
+        The solver's settings (``floodsph.scenario.numerics``), with ``particle_spacing_m``
+        given.
+    seg : (k, 4) array
+        Wall segments (x0, y0, x1, y1) [m] that water cannot cross
+        (``floodsph.walls.layout.model_segments``).
+    closed_edges : bool or tuple of str
+        As given to the builder: True, False, or the closed sides.
     boundaries : sequence of floodsph.boundaries.protocol.Boundary
-        Open boundaries (inflows, sinks), each keeping that contract: ``apply`` after each
-        drift (adding to ``volume_in`` / ``volume_out`` what they inject or remove),
-        ``add_ghosts`` and ``impose`` around the density solve, ``protected``, ``max_dt`` and
-        ``opening``.
+        Open boundaries (the open edges, inflows, sinks), each keeping that contract:
+        ``apply`` after each drift (adding to ``volume_in`` / ``volume_out`` what they inject
+        or remove), ``add_ghosts`` and ``impose`` around the density solve, ``protected``,
+        ``max_dt`` and ``opening``.
     refiner : object or None
         Particle splitting and coalescing: ``apply(model) -> (splits, merges)``, called after
         the boundaries once the particles have moved (``floodsph.model.refinement``).
@@ -87,11 +81,8 @@ class FloodModel:
     stage_timer = None  # a class default, so that models pickled before it existed load
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
-                 walls=(), closed_edges: bool = True, boundaries=(), refiner=None):
-        if numerics.particle_spacing_m is None:
-            raise ValueError("FloodModel: numerics.particle_spacing_m must be given (the "
-                             "scenario's default, the DEM cell size, is filled in by "
-                             "floodsph.run.pipeline.build_model)")
+                 seg: np.ndarray, closed_edges: bool | tuple[str, ...], boundaries,
+                 refiner=None):
         self.terrain = terrain
         self.boundaries = list(boundaries)
         self.refiner = refiner
@@ -99,30 +90,22 @@ class FloodModel:
         self.numerics = numerics
         self.scheme = {Stabilisation.LAX_FRIEDRICHS: forces.LAX_FRIEDRICHS,
                        Stabilisation.RIEMANN: forces.RIEMANN}[numerics.stabilisation]
-        closed = set(OPEN_SIDES) if closed_edges is True else set(closed_edges or ())
-        unknown = closed - set(OPEN_SIDES)
-        if unknown:
-            raise ValueError(f"closed_edges: unknown sides {sorted(unknown)}; use {OPEN_SIDES}")
         self.closed_edges = closed_edges
-        open_sides = [side for side in OPEN_SIDES if side not in closed]
-        if open_sides:
-            self.boundaries.insert(0, OpenEdges(terrain.width, terrain.height, open_sides))
+        self.seg = seg
         h0 = numerics.kappa * numerics.particle_spacing_m
-        openings = [b.opening for b in self.boundaries if b.opening is not None]
-        self.seg = model_segments(terrain, walls, closed, closed_edges is not False, openings,
-                                  h0, numerics.particle_spacing_m)
         self.wall_index = WallIndex(
             self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=2.0 * h0)
         self.t = 0.0
         self.steps = 0
         self.volume_in = 0.0
         self.volume_out = 0.0
+        self.volume_seed_adjustment = 0.0
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
                          "wall_reflections": 0, "density_unconverged": 0,
                          "density_capped": 0, "density_held": 0, "particle_updates": 0,
                          "seeds_settled": 0, "settle_steps": 0, "neighbour_builds": 0}
-        self.bed = np.empty((0, 7))
-        self.pair_sums = np.empty((0, forces.SUMS))
+        self.bed = np.empty((0, bedmod.BED_COLUMNS))
+        self.pair_sums = np.empty((0, SUMS))
         self.shores = bool(np.ptp(terrain.elevation) > 0.0)  # a flat bed has no shore to balance
         self.blocked = np.empty(0, dtype=np.bool_)
         self.wdist = np.empty(0)
@@ -130,16 +113,10 @@ class FloodModel:
         self._no_images = (None,)  # the integral walls' image-free lists, per list build
         self.walled = np.zeros(0, dtype=np.bool_)
         self._blocked_nl = None
-        self._nl_fresh = False  # lists built in this step
+        self.lists_fresh = False  # lists built in this step (or local substep)
         self._nl_here = False  # lists built at the current positions
-        for boundary in self.boundaries:
-            boundary.apply(self, 0.0)
-        self._settle_seeds()
-        self._remove_outside(nodata=closed_edges is False)
-        rho_seed = self.particles.rho.copy()
-        self._interactions(settle=True)
-        self.volume_seed_adjustment = self._settle_at_walls(rho_seed)
-        self.dt = self.stable_dt()
+        self.nl = None
+        self.dt = np.inf
 
     def __repr__(self) -> str:
         return (f"FloodModel(t={self.t:.3f} s, steps={self.steps}, particles={self.particles.n}, "
@@ -157,7 +134,7 @@ class FloodModel:
     def stable_dt(self) -> float:
         """dt = cfl min h / (|v| + c) over the water and the open boundaries' buffers [s]."""
         p = self.particles
-        dt = float(forces.stable_dt(p.u, p.v, p.rho, p.h, self.numerics.cfl)) if p.n else np.inf
+        dt = float(time_step.stable_dt(p.u, p.v, p.rho, p.h, self.numerics.cfl)) if p.n else np.inf
         return self._boundaries_dt(dt)
 
     def _boundaries_dt(self, dt: float) -> float:
@@ -171,91 +148,54 @@ class FloodModel:
         """Advance one time step (at most ``dt_max``); return the step taken [s].
 
         With local time stepping the step is a big step of up to 2^K finest steps
-        (:meth:`_step_local`), at the end of which every particle is synchronised.
+        (``floodsph.model.local_stepping.big_step``), at the end of which every particle is
+        synchronised.
         """
         timer = self.stage_timer
         if timer is not None:
             timer.begin()
-        self._nl_fresh = False
+        self.lists_fresh = False
         self._nl_here = False
         if getattr(self, "nl", None) is None:  # particles were added or removed between steps
-            self._neighbours()
+            self.update_lists()
         if self.numerics.time_stepping is TimeStepping.LOCAL:
-            dt = self._step_local(dt_max)
+            dt = big_step(self, dt_max)
             if timer is not None:
                 timer.end()
             return dt
         p = self.particles
         dt = self.dt if dt_max is None else min(self.dt, dt_max)
         half = 0.5 * dt
-        forces.kick(p.u, p.v, p.ax, p.ay, half)
-        self._move(dt)
-        self._synchronise()
-        self._interactions()
+        time_step.kick(p.u, p.v, p.ax, p.ay, half)
+        self.move(dt)
+        self.synchronise()
+        self.interactions()
         num = self.numerics
-        dt_water = forces.close_step(p.u, p.v, p.ax, p.ay, half, p.rho, p.h, self.bed[: p.n, 6],
-                                     dt, num.friction_depth_floor_m, num.cfl)
-        self._advance_clock(dt)
+        dt_water = time_step.close_step(p.u, p.v, p.ax, p.ay, half, p.rho, p.h,
+                                     self.bed[: p.n, bedmod.MANNING], dt,
+                                     num.friction_depth_floor_m, num.cfl)
+        self.advance_clock(dt)
         self.dt = self._boundaries_dt(float(dt_water))
         if timer is not None:
             timer.end()
         return dt
 
-    def _step_local(self, dt_max: float | None) -> float:
-        """One big step of 2^k finest steps dt_f = ``self.dt``, k <= ``step_levels`` (fewer
-        when ``dt_max`` is shorter), each particle at its own stride (module docstring of
-        ``floodsph.sph.local_steps``); a single step of ``dt_max`` if that is below dt_f."""
-        p = self.particles
-        dt_f = self.dt if dt_max is None else min(self.dt, dt_max)
-        levels = self.numerics.step_levels
-        if dt_max is not None:
-            levels = min(levels, int(math.floor(math.log2(dt_max / dt_f) + 1e-12)))
-        n_sub = 2 ** levels
-        stride = np.empty(p.n, dtype=np.int64)
-        local_steps.strides(p.u, p.v, p.rho, p.h, self.numerics.cfl, dt_f, n_sub, stride)
-        local_steps.limit_strides(stride, self.nl.start, self.nl.nbr, p.n, p.stride)
-        zone = np.zeros(p.n, dtype=bool)
-        for boundary in self.boundaries:
-            zone |= boundary.protected(p.x, p.y)
-        p.stride[zone] = 1
-        half = 0.5 * dt_f
-        end = np.arange(p.n, dtype=np.int64)  # every particle's step begins at finest step 0
-        for sub in range(n_sub):
-            self._nl_fresh = False
-            # the steps that end at finest step sub begin anew: no particle has been added or
-            # removed since (the boundaries do that in the drift, and refinement at the end)
-            begin = end
-            local_steps.kick(begin, p.stride, half, p.u, p.v, p.ax, p.ay)
-            self._move(dt_f)
-            p.stride[p.stride == 0] = 1  # water that entered in this substep: finest stride
-            last = sub == n_sub - 1
-            if last:
-                self._synchronise(n_sub)  # new particles inherit their parents' strides
-            end = None if last else local_steps.step_ends(p.stride, sub + 1)
-            self._interactions(rows=end)
-            end = np.arange(p.n, dtype=np.int64) if end is None else end
-            local_steps.close_steps(end, p.stride, dt_f, p.u, p.v, p.ax, p.ay, p.rho,
-                                    self.bed[:, 6], self.numerics.friction_depth_floor_m)
-            self._advance_clock(dt_f, end.size)
-        self.dt = self.stable_dt()
-        return n_sub * dt_f
-
-    def _move(self, dt: float) -> None:
+    def move(self, dt: float) -> None:
         """Drift every particle by dt (walls reflect), let the open boundaries act, drop what
         left the domain, and advance density and h by the continuity guess."""
         p = self.particles
         self.counters["wall_reflections"] += int(sight.drift(
-            p.x, p.y, p.u, p.v, dt, *self.walls_near[:2], self.seg))
+            p.x, p.y, p.u, p.v, dt, self.walls_near.wstart, self.walls_near.wseg, self.seg))
         self._nl_here = False
         self._lap("kick_drift")
         for boundary in self.boundaries:
             boundary.apply(self, dt)
-        self._remove_outside(nodata=self.closed_edges is False)
+        self.remove_outside(nodata=self.closed_edges is False)
         self._lap("boundaries")
         density.predict(p.rho, p.h, p.divv, dt)
         self._lap("density")
 
-    def _synchronise(self, steps_taken: int = 1) -> None:
+    def synchronise(self, steps_taken: int = 1) -> None:
         """Refinement, and the periodic re-sort, on synchronised particles; ``steps_taken``
         finest steps end here (the re-sort is due when they cross a multiple of its interval)."""
         if self.refiner is not None:
@@ -272,7 +212,7 @@ class FloodModel:
         if self.stage_timer is not None:
             self.stage_timer.lap(stage)
 
-    def _advance_clock(self, dt: float, updated: int | None = None) -> None:
+    def advance_clock(self, dt: float, updated: int | None = None) -> None:
         """t += dt, one more finest step, and the counters of particles and updates."""
         p = self.particles
         self.t += dt
@@ -292,14 +232,14 @@ class FloodModel:
         n = x.shape[0]
         reach = 2.0 * (1.0 + self.numerics.neighbour_skin)
         wstart = self.wall_index.near_lists(x, y, h, np.zeros(n + 1, dtype=np.int64),
-                                            np.zeros(0, dtype=np.int64), reach)[0]
+                                            np.zeros(0, dtype=np.int64), reach).wstart
         mask = np.diff(wstart) > 0
         for boundary in self.boundaries:
             mask |= boundary.protected(x, y)
         return mask
 
     # -- stages --------------------------------------------------------------------------------
-    def _interactions(self, settle: bool = False, rows: np.ndarray | None = None) -> None:
+    def interactions(self, settle: bool = False, rows: np.ndarray | None = None) -> None:
         """Neighbours, density and forces of the water, with the boundaries' ghosts present.
 
         The ghosts (inflow buffers, mirror images beyond open edges) are appended behind the
@@ -313,125 +253,25 @@ class FloodModel:
             boundary.add_ghosts(self)
         self._lap("boundaries")
         if rows is None:
-            self._neighbours()
+            self.update_lists()
         else:
             ghosts = np.arange(water[0], p.n, dtype=np.int64)
-            self._neighbours(force=True, rows=np.concatenate([rows, ghosts]))
+            self.update_lists(force=True, rows=np.concatenate([rows, ghosts]))
         self._solve_density(settle)
         self._lap("density")
         for boundary in self.boundaries:
             boundary.impose(self)
         self._lap("boundaries")
-        self._forces()
+        self.evaluate_forces()
         self._lap("forces")
         p.truncate(water)
 
-    def _settle_seeds(self) -> None:
-        """Move seeds off nodata and off wall lines (``settle_seeds``); those that cannot be
-        moved are removed and counted as outflow."""
-        p, t = self.particles, self.terrain
-        walled = self.closed_edges is not False
-        x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy,
-                                  self.numerics.particle_spacing_m, self.seg if walled else None)
-        p.x[:], p.y[:] = x, y
-        if lost.any():
-            self.volume_out += float(p.m[lost].sum() / RHO_WATER)
-            p.keep(~lost)
-
-    def _settle_at_walls(self, rho_seed: np.ndarray) -> float:
-        """Settle the seeds of still water next to walls, then match their depth to the seeded
-        rho_seed / rho_w (``floodsph.walls.seeding``); return the volume change [m3]."""
-        idx = self._wall_seeds(rho_seed)
-        self.counters["seeds_settled"] = int(idx.size)
-        if idx.size == 0:
-            return 0.0
-        rows = wall_seeding.neighbourhood(idx, self.nl.start, self.nl.nbr, self.particles.n,
-                                          wall_seeding.RINGS)
-        rounds = self._settle(idx, rows)
-        v0 = self.particles.volume()
-        rounds += self._match_masses(idx, rho_seed[idx], rows)
-        if rounds:  # lists and sums of every particle again, for the first step
-            self._interactions(settle=True)
-        return self.particles.volume() - v0
-
-    def _wall_seeds(self, rho_seed: np.ndarray) -> np.ndarray:
-        """Indices of the lattice seeds (m = rho_seed spacing^2) near a wall, out of open
-        boundaries' zones, in still water (``wall_seeding.still_water``) and enclosed within
-        ``wall_seeding.ENCLOSURE`` h (``wall_seeding.enclosed_seeds``)."""
-        p = self.particles
-        dx = self.numerics.particle_spacing_m
-        n = p.n
-        candidate = np.abs(p.m - rho_seed * dx * dx) <= 1e-9 * p.m
-        candidate &= np.diff(self.walls_near[0][:n + 1]) > 0
-        for boundary in self.boundaries:
-            candidate &= ~boundary.protected(p.x, p.y)
-        everyone = np.arange(n, dtype=np.int64)
-        still = np.empty(n, dtype=np.bool_)
-        wall_seeding.still_water(everyone, self.nl.start, self.nl.nbr, n, p.u, p.v,
-                                 self.bed[:n, 0], rho_seed / RHO_WATER,
-                                 wall_seeding.LEVEL_TOLERANCE, still)
-        rows = np.flatnonzero(candidate)
-        calm = np.empty(rows.size, dtype=np.bool_)
-        wall_seeding.with_neighbours(rows, self.nl.start, self.nl.nbr, n, still, calm)
-        rows = rows[calm]
-        wstart, wseg = self.wall_index.near_lists(p.x, p.y, p.h, np.zeros(n + 1, dtype=np.int64),
-                                                  np.zeros(0, dtype=np.int64),
-                                                  wall_seeding.ENCLOSURE)[:2]
-        return wall_seeding.enclosed_seeds(p.x, p.y, wall_seeding.ENCLOSURE * p.h, rows,
-                                           dx, wstart, wseg, self.seg)
-
-    def _settle(self, idx: np.ndarray, rows: np.ndarray) -> int:
-        """Move the particles ``idx`` by a dt^2 / 2 per round, along their acceleration (walls
-        reflecting), with dt the model's CFL step, each at most ``wall_seeding.MAX_SHIFT``
-        spacings in all from its seed, the others held, until |a| < ``wall_seeding.SETTLED`` g
-        or for ``wall_seeding.SETTLE_STEPS`` rounds. Each round solves density and forces
-        for ``rows`` alone: ``idx`` and every particle whose density they may change. Returns
-        the number of rounds."""
-        p = self.particles
-        x0, y0 = p.x[idx].copy(), p.y[idx].copy()
-        mx, my = np.zeros(p.n), np.zeros(p.n)
-        limit = wall_seeding.MAX_SHIFT * self.numerics.particle_spacing_m
-        taken = 0
-        while (taken < wall_seeding.SETTLE_STEPS
-               and np.hypot(p.ax[idx], p.ay[idx]).max() >= wall_seeding.SETTLED * GRAVITY):
-            mx[idx], my[idx] = wall_seeding.limited_move(p.ax[idx], p.ay[idx], self.stable_dt(),
-                                                         p.x[idx] - x0, p.y[idx] - y0, limit)
-            sight.drift(p.x, p.y, mx, my, 1.0, *self.walls_near[:2], self.seg)
-            self._interactions(settle=True, rows=rows)
-            taken += 1
-        self.counters["settle_steps"] = taken
-        return taken
-
-    def _match_masses(self, idx: np.ndarray, rho_target: np.ndarray, rows: np.ndarray) -> int:
-        """Jacobi iteration m_i <- m_i rho_target_i / rho_i on the particles ``idx``, each
-        mass kept within [``MASS_MIN``, ``MASS_MAX``] times its start (``wall_seeding``);
-        density and forces solved for ``rows`` alone (:meth:`_settle`). Returns the number of
-        solves."""
-        p = self.particles
-        m0 = p.m[idx].copy()
-        solves = 0
-        while solves < wall_seeding.ROUNDS:
-            ratio = rho_target / p.rho[idx]
-            if np.abs(ratio - 1.0).max() < wall_seeding.TOLERANCE:
-                break
-            p.m[idx] = np.clip(p.m[idx] * ratio, wall_seeding.MASS_MIN * m0,
-                               wall_seeding.MASS_MAX * m0)
-            self._interactions(settle=True, rows=rows)
-            solves += 1
-        return solves
-
-    def _remove_outside(self, nodata: bool) -> None:
+    def remove_outside(self, nodata: bool) -> None:
         """Remove (and count as outflow) particles off the grid, and in nodata cells if
         ``nodata``, i.e. when nodata is not walled off (the walled nodata border runs through
         nodata cells, whose slivers are then wet area)."""
         p = self.particles
-        t = self.terrain
-        ny, nx = t.shape
-        col = np.floor(p.x / t.dx).astype(np.int64)
-        row = np.floor(p.y / t.dy).astype(np.int64)
-        inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
-        if nodata:
-            inside[inside] = t.valid[row[inside], col[inside]]
+        inside = self.terrain.covers(p.x, p.y, valid_only=nodata)
         if not inside.all():
             self.volume_out += float(p.m[~inside].sum() / RHO_WATER)
             p.keep(inside)
@@ -440,11 +280,10 @@ class FloodModel:
         """Sort particles by cell so that neighbours are close in memory."""
         p = self.particles
         if p.n:
-            grid = CellGrid(p.x, p.y, 2.0 * float(np.mean(p.h)))
-            p.permute(grid.order)
+            p.permute(CellGrid(p.x, p.y, 2.0 * float(np.mean(p.h))).order)
             self.nl = None
 
-    def _neighbours(self, force: bool = False, rows: np.ndarray | None = None) -> None:
+    def update_lists(self, force: bool = False, rows: np.ndarray | None = None) -> None:
         """Neighbour and near-wall lists, rebuilt when the Verlet skin is used up (or ``force``).
 
         The lists are built for h_i times the growth of h_i in the last density solve
@@ -458,7 +297,7 @@ class FloodModel:
         if not force and nl is not None and nl.still_valid(p.x, p.y, p.h):
             self._lap("neighbours")
             return
-        self._nl_fresh = True
+        self.lists_fresh = True
         self.counters["neighbour_builds"] += 1
         self._nl_here = True  # built at the current positions (until the next drift)
         h_search = p.h * np.clip(p.hgrow, 1.0, MAX_SEARCH_GROWTH)
@@ -468,17 +307,18 @@ class FloodModel:
                                                      self.nl.nbr, self.nl.reach)
         self._lap("neighbours")
 
-    def _blocked_pairs(self) -> None:
+    def block_pairs(self) -> None:
         """Flag the listed pairs that a wall separates, and measure the distances to the near
         segments, at the current positions."""
         p = self.particles
         self._blocked_nl = self.nl
         if self.blocked.shape[0] != self.nl.nbr.shape[0]:
             self.blocked = np.empty(self.nl.nbr.shape[0], dtype=np.bool_)
-        if self.wdist.shape[0] != self.walls_near[1].shape[0]:
-            self.wdist = np.empty(self.walls_near[1].shape[0])
+        near = self.walls_near
+        if self.wdist.shape[0] != near.wseg.shape[0]:
+            self.wdist = np.empty(near.wseg.shape[0])
         sight.blocked_pairs(self.nl.rows, p.x, p.y, self.nl.start, self.nl.nbr,
-                              *self.walls_near[:2], self.seg, self.blocked, self.wdist)
+                              near.wstart, near.wseg, self.seg, self.blocked, self.wdist)
 
     def _image_lists(self):
         """The wall arguments (wdist, wstart, wseg, cstart, cpair) of the density and force
@@ -509,7 +349,7 @@ class FloodModel:
         p = self.particles
         h_predicted = p.h.copy()
         for _ in range(SETTLE_ROUNDS if settle else 2):
-            self._blocked_pairs()
+            self.block_pairs()
             wdist, *walls = self._image_lists()
             outcome = density.solve_density(
                 p, self.nl, self.blocked, wdist, walls, self.seg,
@@ -517,10 +357,10 @@ class FloodModel:
                 cap=not settle, integral=self.integral_walls, unmoved=self._nl_here)
             if settle and self.nl.covers(p.x, p.y, p.h):
                 break
-            if not settle and (outcome.capped == 0 or self._nl_fresh):
+            if not settle and (outcome.capped == 0 or self.lists_fresh):
                 break
             self._lap("density")
-            self._neighbours(force=True, rows=None if self.nl.complete else self.nl.rows)
+            self.update_lists(force=True, rows=None if self.nl.complete else self.nl.rows)
         rows = self.nl.rows
         if self.nl.complete:
             p.hgrow[:] = p.h / h_predicted
@@ -530,16 +370,16 @@ class FloodModel:
         self.counters["density_capped"] += outcome.capped
         self.counters["density_held"] += outcome.held
 
-    def _forces(self) -> None:
+    def evaluate_forces(self) -> None:
         p = self.particles
         t = self.terrain
         if self.bed.shape[0] != p.n:
-            self.bed = np.empty((p.n, 7))
-            self.pair_sums = np.empty((p.n, forces.SUMS))
+            self.bed = np.empty((p.n, bedmod.BED_COLUMNS))
+            self.pair_sums = np.empty((p.n, SUMS))
         rows = self.nl.rows
         bedmod.sample_bed(rows, p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
-            self._blocked_pairs()
+            self.block_pairs()
         forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, p.kxx,
                                      p.kxy, p.kyy, self.nl.start, self.nl.nbr, self.blocked,
                                      *self._image_lists(), self.seg, self.scheme,
@@ -549,8 +389,9 @@ class FloodModel:
         if self.walled.shape[0] != p.n:
             self.walled = np.zeros(p.n, dtype=np.bool_)
         if self.integral_walls:
-            shadow.balance_walls(rows, p.x, p.y, p.rho, p.h, *self.walls_near[:2], self.seg,
-                                      self.pair_sums, p.ax, p.ay, self.walled)
+            shadow.balance_walls(rows, p.x, p.y, p.rho, p.h, self.walls_near.wstart,
+                                 self.walls_near.wseg, self.seg, self.pair_sums, p.ax, p.ay,
+                                 self.walled)
         if self.shores:
             shore.balance_shores(rows, p.x, p.y, p.u, p.v, p.rho, p.h, self.bed, t.dx, t.dy,
                                  t.elevation, self.pair_sums, self.walled, p.ax, p.ay)

@@ -174,17 +174,18 @@ class Refiner:
         h_parent = _parent_h(p, idx, model.numerics.kappa, s.refine_smoothing_excess)
         x, y, _ = _daughter_positions(p, idx, h_parent)
         walled = model.closed_edges is not False
-        ok = _on_terrain(model.terrain, x, y, nodata_ok=walled)
+        ok = model.terrain.covers(x, y, valid_only=not walled)  # walled nodata slivers are wet area
         ok = ok.reshape(-1, refine.DAUGHTERS).all(axis=1)
         wi = model.wall_index
         if wi.seg.shape[0]:
             n = idx.size
             d = refine.DAUGHTERS
             radius = np.hypot(x[1::d] - p.x[idx], y[1::d] - p.y[idx])
-            wstart, wseg = wi.near_lists(p.x[idx], p.y[idx], radius, np.zeros(n + 1, np.int64),
-                                         np.zeros(0, np.int64), HEXAGON_MARGIN)[:2]
+            near = wi.near_lists(p.x[idx], p.y[idx], radius, np.zeros(n + 1, np.int64),
+                                 np.zeros(0, np.int64), HEXAGON_MARGIN)
             clear = np.empty(n, dtype=np.bool_)
-            refine.daughters_clear(p.x[idx], p.y[idx], x, y, wstart, wseg, wi.seg, clear)
+            refine.daughters_clear(p.x[idx], p.y[idx], x, y, near.wstart, near.wseg, wi.seg,
+                                   clear)
             ok &= clear
         return idx[ok]
 
@@ -375,16 +376,3 @@ def _parent_h(p, idx, kappa: float, excess: float) -> np.ndarray:
     """
     return np.minimum(p.h[idx], math.sqrt(excess) * kappa
                       * np.sqrt(p.m[idx] / p.rho[idx]))
-
-
-def _on_terrain(terrain, x, y, nodata_ok: bool) -> np.ndarray:
-    """True for points on the terrain grid (local coordinates), and on a valid cell unless
-    ``nodata_ok`` (nodata walled off: its slivers inside the walls are wet area, and
-    ``daughters_clear`` keeps daughters on their parent's side of every wall)."""
-    ny, nx = terrain.shape
-    col = np.floor(x / terrain.dx).astype(np.int64)
-    row = np.floor(y / terrain.dy).astype(np.int64)
-    inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
-    if not nodata_ok:
-        inside[inside] = terrain.valid[row[inside], col[inside]]
-    return inside

@@ -123,6 +123,17 @@ class Terrain:
         """Local coordinates to world (CRS) coordinates [m]."""
         return np.asarray(x, dtype=np.float64) + self.x0, np.asarray(y, dtype=np.float64) + self.y0
 
+    def covers(self, x, y, valid_only: bool) -> np.ndarray:
+        """True for the points (x, y) [m, local] on the grid, and, with ``valid_only``, in a
+        cell that is not nodata."""
+        ny, nx = self.shape
+        col = np.floor(x / self.dx).astype(np.int64)
+        row = np.floor(y / self.dy).astype(np.int64)
+        inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
+        if valid_only:
+            inside[inside] = self.valid[row[inside], col[inside]]
+        return inside
+
     def cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
         """Local x of the columns and local y of the rows (south to north) [m]."""
         ny, nx = self.shape

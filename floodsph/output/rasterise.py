@@ -22,7 +22,7 @@ not mapped: it carries a negligible volume.
 
 The loop gathers over the target points (iteration k writes only the sums of point k), so it
 is race-free under ``prange``. Particles are binned with
-:class:`floodsph.sph.neighbours.CellGrid` by the levels of h of the neighbour search
+:class:`floodsph.sph.cells.CellGrid` by the levels of h of the neighbour search
 (:func:`floodsph.sph.neighbours.h_levels`: level 0 up to 1.25 median h, then factors of
 2), each level in cells of twice its largest h, so that particles with a large h do not
 inflate the cell size for all; each level is searched in the 3 x 3 cells around the point,
@@ -50,8 +50,9 @@ from numba import njit, prange
 from scipy import ndimage
 
 from floodsph.constants import RHO_WATER
+from floodsph.sph.cells import CellGrid
 from floodsph.sph.kernels import w_cubic
-from floodsph.sph.neighbours import LEVEL_BASE, CellGrid, h_levels
+from floodsph.sph.neighbours import LEVEL_BASE, h_levels
 
 MIN_SUPPORT = 0.5
 """Default minimum kernel sum S = sum_j V_j W for a point to be mapped (see module doc)."""

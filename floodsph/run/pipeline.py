@@ -28,8 +28,9 @@ from floodsph.errors import InputError
 from floodsph.run.atomic_files import TEMP_PREFIX, atomic_path
 from floodsph.run.atomic_files import umask as _umask
 from floodsph.run.folder import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME, RunFolder
+from floodsph.run.log_file import attach_log, detach_log
 from floodsph.run.manifest import new_manifest, now_iso, write_manifest
-from floodsph.scenario.config import Edges, Scenario
+from floodsph.scenario.config import Scenario
 from floodsph.scenario.writer import write_resolved
 from floodsph.simulation.schedules import time_tolerance
 from floodsph.simulation.stop_signals import StopSignals
@@ -135,7 +136,7 @@ def _resumable(folder: RunFolder, scenario: Scenario, inputs, threads: int):
 
 def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
     """The run proper, in the opened folder ``work``; see :func:`run_scenario`."""
-    log_handler = _attach_log(work / LOG_NAME, append=checkpoint is not None)
+    log_handler = attach_log(work / LOG_NAME, append=checkpoint is not None)
     manifest = new_manifest(scenario.to_dict())
     manifest.update(
         threads=opts.threads,
@@ -157,6 +158,8 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
         log.info("run folder %s; %d particles, spacing %g m", folder.path, inputs.particles.n,
                  inputs.spacing_m)
         if checkpoint is None:
+            from floodsph.model.from_scenario import build_model
+
             model = build_model(scenario, inputs)
         else:
             model = checkpoint.model
@@ -195,7 +198,7 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
             recorders.close()
         _finish_manifest(manifest, model, mass, time.monotonic() - wall_start)
         _final_manifest(folder, work, manifest)
-        _detach_log(*log_handler)
+        detach_log(*log_handler)
     return manifest
 
 
@@ -271,57 +274,6 @@ def set_threads(threads: int) -> int:
         log.warning("%d threads asked for, %d available; using %d", threads, available, n)
     numba.set_num_threads(n)
     return n
-
-
-def build_model(scenario: Scenario, inputs):
-    """The FloodModel of ``scenario`` from prepared inputs, with its open boundaries.
-
-    The model's numerics are the scenario's, with ``particle_spacing_m`` the spacing the
-    particles were seeded at (the DEM cell size when the scenario gives none).
-    """
-    from dataclasses import replace
-
-    from floodsph.model.flood_model import FloodModel
-    from floodsph.model.refinement import Refiner
-
-    numerics = replace(scenario.numerics, particle_spacing_m=inputs.spacing_m)
-    return FloodModel(
-        inputs.terrain,
-        inputs.particles,
-        numerics,
-        walls=inputs.walls,
-        closed_edges=_closed_edges(scenario.terrain),
-        boundaries=open_boundaries(scenario, inputs, numerics),
-        refiner=Refiner.of(numerics),
-    )
-
-
-def _closed_edges(terrain) -> bool | tuple[str, ...]:
-    """``FloodModel(closed_edges=...)``: True, False, or the sides kept closed."""
-    if terrain.edges is Edges.CLOSED:
-        return True
-    return terrain.closed_sides or False
-
-
-def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
-    """The ``[[inflows]]`` sections and ``[[sinks]]`` polygons (``inputs.sinks``, inline or
-    from vector files) as model boundaries."""
-    import numpy as np
-
-    from floodsph.boundaries import Inflow, Sink
-
-    terrain = inputs.terrain
-    source = scenario.path.name
-    out = []
-    for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,
-                                                 strict=True)):
-        line = np.column_stack(terrain.to_local(*np.asarray(inflow.line, dtype=np.float64).T))
-        out.append(Inflow(line, hydrograph, numerics.particle_spacing_m, numerics.kappa, terrain,
-                          direction=inflow.direction, name=f"{source}: inflows[{i}]"))
-    reach = 4.0 * numerics.kappa * numerics.particle_spacing_m
-    for polygon in inputs.sinks:
-        out.append(Sink(polygon, terrain, reach))
-    return out
 
 
 def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]:
@@ -437,27 +389,3 @@ def _inflow_summary(inflow) -> dict:
         "volume_injected_m3": float(inflow.volume_in),
         "volume_hydrograph_m3": float(inflow.hydrograph.volume(0.0, inflow.t)),
     }
-
-
-def _attach_log(path: Path, append: bool = False) -> tuple[logging.Handler, int]:
-    """Send floodsph's INFO (and higher) records to ``path`` for the length of the run
-    (appended to a resumed run's log).
-
-    Returns the handler and the logger level to restore afterwards.
-    """
-    handler = logging.FileHandler(path, mode="a" if append else "w", encoding="utf-8")
-    handler.setLevel(logging.INFO)
-    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
-    logger = logging.getLogger("floodsph")
-    previous = logger.level
-    if logger.getEffectiveLevel() > logging.INFO:
-        logger.setLevel(logging.INFO)
-    logger.addHandler(handler)
-    return handler, previous
-
-
-def _detach_log(handler: logging.Handler, previous_level: int) -> None:
-    logger = logging.getLogger("floodsph")
-    logger.removeHandler(handler)
-    logger.setLevel(previous_level)
-    handler.close()

@@ -87,8 +87,8 @@ class Numerics:
     Scenario keys (``[numerics]``):
 
     particle_spacing_m : initial particle spacing [m]; None (the scenario's default) means the
-        DEM cell size, which ``floodsph.run.pipeline.build_model`` fills in: the model needs a
-        number.
+        DEM cell size, which ``floodsph.model.from_scenario.build_model`` fills in: the model
+        needs a number.
     cfl : Courant number of dt = cfl min h / (|v| + c).
     refinement : splitting and coalescing of particles (``floodsph.model.refinement``).
     threads : numba threads of a run; 0 means all cores.

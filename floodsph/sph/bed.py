@@ -16,6 +16,11 @@ import math
 
 from numba import njit, prange
 
+BED, SLOPE_X, SLOPE_Y, CURV_XX, CURV_XY, CURV_YY, MANNING = range(7)
+"""The named columns of a bed sample (:func:`sample_bed`): b [m], b_x, b_y [-],
+b_xx, b_xy, b_yy [m^-1], Manning's n [s m^-1/3]."""
+BED_COLUMNS = 7
+
 
 @njit(inline="always", cache=True)
 def _weights(x, y, dx, dy, nx, ny):
@@ -51,18 +56,16 @@ def elevation_at(x, y, dx, dy, grid, nx, ny):
 
 @njit(parallel=True, cache=True)
 def sample_bed(rows, x, y, dx, dy, bed, bx, by, bxx, bxy, byy, manning, out):
-    """Sample the seven bed grids at the particles ``rows`` into their rows of ``out`` (n, 7).
-
-    Columns: b [m], b_x, b_y [-], b_xx, b_xy, b_yy [m^-1], n [s m^-1/3].
-    """
+    """Sample the seven bed grids at the particles ``rows`` into their rows of ``out``
+    (n, ``BED_COLUMNS``), in the named columns ``BED`` ... ``MANNING``."""
     ny, nx = bed.shape
     for k in prange(rows.shape[0]):
         p = rows[k]
         i0, j0, tx, ty = _weights(x[p], y[p], dx, dy, nx, ny)
-        out[p, 0] = _lerp(bed, i0, j0, tx, ty)
-        out[p, 1] = _lerp(bx, i0, j0, tx, ty)
-        out[p, 2] = _lerp(by, i0, j0, tx, ty)
-        out[p, 3] = _lerp(bxx, i0, j0, tx, ty)
-        out[p, 4] = _lerp(bxy, i0, j0, tx, ty)
-        out[p, 5] = _lerp(byy, i0, j0, tx, ty)
-        out[p, 6] = _lerp(manning, i0, j0, tx, ty)
+        out[p, BED] = _lerp(bed, i0, j0, tx, ty)
+        out[p, SLOPE_X] = _lerp(bx, i0, j0, tx, ty)
+        out[p, SLOPE_Y] = _lerp(by, i0, j0, tx, ty)
+        out[p, CURV_XX] = _lerp(bxx, i0, j0, tx, ty)
+        out[p, CURV_XY] = _lerp(bxy, i0, j0, tx, ty)
+        out[p, CURV_YY] = _lerp(byy, i0, j0, tx, ty)
+        out[p, MANNING] = _lerp(manning, i0, j0, tx, ty)

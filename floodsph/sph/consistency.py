@@ -57,6 +57,7 @@ from numba import njit, prange
 
 from floodsph.constants import GRAVITY
 from floodsph.sph.shore import FULL_SUPPORT, moment_matrix
+from floodsph.sph.sums import E_X, E_Y, MOMENT_X, MOMENT_Y
 
 EDGE = 0.1  # |e| h at and above which i's own support counts as cut: no renormalisation
 DET_MIN = 0.5  # det M below which a support is too distorted to renormalise
@@ -65,7 +66,7 @@ DET_MIN = 0.5  # det M below which a support is too distorted to renormalise
 @njit(parallel=True, cache=True)
 def update_renormalisation(rows, h, sums, shores, kxx, kxy, kyy):
     """Set K = (M / sqrt(det M))^-1 - I (kxx, kxy, kyy) of the particles ``rows`` from their
-    sums (columns 2-3: E, 4-6: g M, 7-8: e, of ``floodsph.sph.forces.internal_acceleration``);
+    sums (E, g M and e of ``floodsph.sph.sums``);
     K = 0 where the support is cut, with ``shores`` (a bed that is not flat) also where the
     shore balance may act, and where det M < ``DET_MIN`` (module docstring)."""
     for k in prange(rows.shape[0]):
@@ -73,9 +74,9 @@ def update_renormalisation(rows, h, sums, shores, kxx, kxy, kyy):
         kxx[i] = 0.0
         kxy[i] = 0.0
         kyy[i] = 0.0
-        if math.hypot(sums[i, 7], sums[i, 8]) * h[i] >= EDGE:
+        if math.hypot(sums[i, MOMENT_X], sums[i, MOMENT_Y]) * h[i] >= EDGE:
             continue
-        if shores and math.hypot(sums[i, 2], sums[i, 3]) * h[i] >= FULL_SUPPORT * GRAVITY:
+        if shores and math.hypot(sums[i, E_X], sums[i, E_Y]) * h[i] >= FULL_SUPPORT * GRAVITY:
             continue
         mxx, mxy, myy, det = moment_matrix(sums, i)
         if det < DET_MIN:

@@ -1,4 +1,4 @@
-"""Accelerations: the variational pressure force with shock capturing, bed and friction.
+"""Accelerations: the variational pressure force with shock capturing, and the bed.
 
 Internal (pressure) acceleration with the grad-h correction (Vacondio et al. 2013 via
 Rodriguez-Paz & Bonet 2005; method notes eq. (4)), with beta_i = 2 rho_i / alpha_i:
@@ -35,11 +35,11 @@ the real neighbours do not (it sped up the thin front of a dam break in a 100 m 
 The same loop returns the velocity divergence used for the continuity-based density guess,
 div v_i = -(2 / alpha_i) sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i).
 
-Bed and friction (pointwise, method notes eq. (5) and 2.5):
+Bed (pointwise, method notes eq. (5)):
 
     a_i = a_i^int - [(g + v.K.v + a_i^int . grad b) / (1 + |grad b|^2)] grad b
-    v  <- 2 v / (1 + sqrt(1 + 4 beta)),  beta = dt g n^2 |v| / max(d, d_floor)^(4/3)
-          (implicit Manning, :func:`friction_factor`)
+
+Friction and the time step's kicks are ``floodsph.sph.time_step``'s.
 
 Units: accelerations [m s-2], rho [kg m-2], m [kg], h and r [m].
 """
@@ -52,7 +52,9 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
+from floodsph.sph.bed import CURV_XX, CURV_XY, CURV_YY, SLOPE_X, SLOPE_Y
 from floodsph.sph.kernels import dwdr_over_r_cubic, dwdr_over_r_floored
+from floodsph.sph.sums import D_X, MOMENT_X, MOMENT_Y
 from floodsph.walls.geometry import mirror
 from floodsph.walls.images import corner_image
 from floodsph.walls.sight import SIGHT_SLACK, hides
@@ -165,8 +167,9 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nst
     :meth:`floodsph.walls.index.WallIndex.near_lists`; images are summed segment by segment,
     each followed by the corners it opens, as in the density summation.
 
-    Row i of ``sums`` (n, SUMS) receives particle i's sums of :func:`_subtract` (columns 2-8,
-    then 10-11), for ``floodsph.sph.shore`` and ``floodsph.sph.consistency``; the
+    Row i of ``sums`` (n, ``floodsph.sph.sums.SUMS``) receives particle i's sums of
+    :func:`_subtract` (its terms 2-8, then 10-11, as the named columns of
+    ``floodsph.sph.sums``), for ``floodsph.sph.shore`` and ``floodsph.sph.consistency``; the
     pressure renormalisation K (kxx, kxy, kyy) is the one the latter set from them at i's
     previous force evaluation.
     """
@@ -202,14 +205,11 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nst
                 c += 1
         ax[i] = acc[0]
         ay[i] = acc[1]
-        for c in range(7):
-            sums[i, c] = acc[2 + c]
-        sums[i, 7] = acc[10]
-        sums[i, 8] = acc[11]
+        for c in range(7):  # D, E and g M
+            sums[i, D_X + c] = acc[2 + c]
+        sums[i, MOMENT_X] = acc[10]
+        sums[i, MOMENT_Y] = acc[11]
         divv[i] = coef[i, 0] * acc[9] / rho[i]  # (2 / alpha_i) fd, with beta's fallback
-
-
-SUMS = 9  # columns of the sums: D (x, y), E (x, y), g M (xx, xy, yy), e (x, y)
 
 
 @njit(inline="always", cache=True)
@@ -327,91 +327,15 @@ def add_bed_acceleration(rows, u, v, bed, max_slope, ax, ay):
     """
     for k in prange(rows.shape[0]):
         i = rows[k]
-        bx = bed[i, 1]
-        by = bed[i, 2]
+        bx = bed[i, SLOPE_X]
+        by = bed[i, SLOPE_Y]
         s = math.sqrt(bx * bx + by * by)
         if s > max_slope:
             bx *= max_slope / s
             by *= max_slope / s
-        vkv = u[i] * (bed[i, 3] * u[i] + bed[i, 4] * v[i]) + v[i] * (bed[i, 4] * u[i]
-                                                                      + bed[i, 5] * v[i])
+        vkv = (u[i] * (bed[i, CURV_XX] * u[i] + bed[i, CURV_XY] * v[i])
+               + v[i] * (bed[i, CURV_XY] * u[i] + bed[i, CURV_YY] * v[i]))
         f = (GRAVITY + vkv + ax[i] * bx + ay[i] * by) / (1.0 + bx * bx + by * by)
         f = max(f, 0.0)
         ax[i] -= f * bx
         ay[i] -= f * by
-
-
-@njit(inline="always", cache=True)
-def friction_factor(u, v, rho, n, dt, d_floor):
-    """Implicit Manning factor f = 2 / (1 + sqrt(1 + 4 beta)) [-] of one particle, with
-    beta = dt g n^2 |v| / max(d, d_floor)^(4/3) (velocity v [m s-1] after the closing kick,
-    rho [kg m-2], n [s m-1/3], dt [s], floor [m]).
-
-    f v is the exact solution of the backward-Euler friction step
-    v_new = v - dt g n^2 |v_new| v_new / d^(4/3): v_new is parallel to v, and its speed s
-    solves s + (beta / |v|) s^2 = |v|. A particle kicked by a constant acceleration a then
-    keeps Manning's terminal speed, a = g n^2 |v|^2 / d^(4/3), at any dt. The point-implicit
-    factor 1 / (1 + beta) of the method notes (2.5) settles at u_e (sqrt(beta_e^2 + 4) -
-    beta_e) / 2 with beta_e = dt g n^2 u_e / d^(4/3): 5 % slow at beta_e = 0.1, which the
-    long steps of slow, thin particles under local time stepping reach on a flood plain.
-    Like it, f lies in (0, 1], so friction cannot reverse the flow, for any dt.
-    """
-    d = max(rho / RHO_WATER, d_floor)
-    speed = math.sqrt(u * u + v * v)
-    beta = dt * GRAVITY * n * n * speed / d ** (4.0 / 3.0)
-    return 2.0 / (1.0 + math.sqrt(1.0 + 4.0 * beta))
-
-
-@njit(parallel=True, cache=True)
-def apply_friction(u, v, rho, manning, dt, d_floor):
-    """Implicit Manning friction over dt: v <- f v (:func:`friction_factor`); n <= 0: none."""
-    for i in prange(u.shape[0]):
-        n = manning[i]
-        if n <= 0.0:
-            continue
-        k = friction_factor(u[i], v[i], rho[i], n, dt, d_floor)
-        u[i] *= k
-        v[i] *= k
-
-
-@njit(inline="always", cache=True)
-def _dt_bound(u, v, rho, h):
-    """h / (|v| + c) [s] of one particle (c = sqrt(g d)), inf if it is still and dry."""
-    c = math.sqrt(GRAVITY * rho / RHO_WATER)
-    w = math.sqrt(u * u + v * v) + c
-    return h / w if w > 0.0 else np.inf
-
-
-@njit(parallel=True, cache=True)
-def stable_dt(u, v, rho, h, cfl):
-    """CFL time step dt = cfl min_i h_i / (|v_i| + c_i), c_i = sqrt(g d_i) [s]."""
-    best = np.inf
-    for i in prange(u.shape[0]):
-        best = min(best, _dt_bound(u[i], v[i], rho[i], h[i]))
-    return cfl * best
-
-
-@njit(parallel=True, cache=True)
-def kick(u, v, ax, ay, half):
-    """Half kick v <- v + a dt / 2 of every particle (``half`` = dt / 2 [s])."""
-    for i in prange(u.shape[0]):
-        u[i] += half * ax[i]
-        v[i] += half * ay[i]
-
-
-@njit(parallel=True, cache=True)
-def close_step(u, v, ax, ay, half, rho, h, manning, dt, d_floor, cfl):
-    """The end of a step in one pass: the closing half kick (:func:`kick`), implicit Manning
-    friction over dt (:func:`apply_friction`), and the next CFL step of :func:`stable_dt`,
-    which is returned [s]."""
-    best = np.inf
-    for i in prange(u.shape[0]):
-        u[i] += half * ax[i]
-        v[i] += half * ay[i]
-        n = manning[i]
-        if n > 0.0:
-            k = friction_factor(u[i], v[i], rho[i], n, dt, d_floor)
-            u[i] *= k
-            v[i] *= k
-        best = min(best, _dt_bound(u[i], v[i], rho[i], h[i]))
-    return cfl * best

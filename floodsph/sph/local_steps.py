@@ -40,7 +40,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.sph.forces import friction_factor
+from floodsph.sph.time_step import friction_factor
 
 
 @njit(parallel=True, cache=True)
@@ -48,7 +48,7 @@ def strides(u, v, rho, h, cfl, dt_fine, max_stride, out):
     """Stride s_i = largest power of two <= min(max_stride, dt_i / dt_fine), at least 1.
 
     dt_i = cfl h_i / (|v_i| + c_i) with c_i = sqrt(g d_i) [s], the particle's own CFL step
-    (:func:`floodsph.sph.forces.stable_dt` is its minimum); ``dt_fine`` [s] the finest step.
+    (:func:`floodsph.sph.time_step.stable_dt` is its minimum); ``dt_fine`` [s] the finest step.
     """
     for i in prange(u.shape[0]):
         w = math.sqrt(u[i] * u[i] + v[i] * v[i]) + math.sqrt(GRAVITY * rho[i] / RHO_WATER)
@@ -94,7 +94,7 @@ def kick(rows, stride, half_dt, u, v, ax, ay):
 @njit(parallel=True, cache=True)
 def close_steps(rows, stride, dt_fine, u, v, ax, ay, rho, manning, d_floor):
     """End the own steps of the particles ``rows``: the half kick v += (s_i dt_f / 2) a_i, then
-    implicit Manning friction over s_i dt_f (:func:`floodsph.sph.forces.friction_factor`;
+    implicit Manning friction over s_i dt_f (:func:`floodsph.sph.time_step.friction_factor`;
     n <= 0 means no friction), as steps 5 of ``floodsph.model.flood_model`` with each particle's
     own step."""
     for k in prange(rows.shape[0]):

@@ -56,7 +56,8 @@ import math
 from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.sph.bed import elevation_at
+from floodsph.sph.bed import BED, elevation_at
+from floodsph.sph.sums import D_X, D_Y, E_X, E_Y, GM_XX, GM_XY, GM_YY
 
 DET_MIN = 0.02  # det M below which a particle's support is too empty to renormalise D
 FULL_SUPPORT = 0.01  # |E| h / g below which a support counts as full: not at an edge
@@ -64,11 +65,11 @@ FULL_SUPPORT = 0.01  # |E| h / g below which a support counts as full: not at an
 
 @njit(inline="always", cache=True)
 def moment_matrix(sums, i):
-    """(M_xx, M_xy, M_yy, det M) [-] of particle i, from the g M of its ``sums`` (columns 4-6
-    of ``floodsph.sph.forces.internal_acceleration``)."""
-    mxx = sums[i, 4] / GRAVITY
-    mxy = sums[i, 5] / GRAVITY
-    myy = sums[i, 6] / GRAVITY
+    """(M_xx, M_xy, M_yy, det M) [-] of particle i, from the g M of its ``sums``
+    (``floodsph.sph.sums``)."""
+    mxx = sums[i, GM_XX] / GRAVITY
+    mxy = sums[i, GM_XY] / GRAVITY
+    myy = sums[i, GM_YY] / GRAVITY
     return mxx, mxy, myy, mxx * myy - mxy * mxy
 
 
@@ -76,19 +77,19 @@ def moment_matrix(sums, i):
 def balance_shores(rows, x, y, u, v, rho, h, bed, dx, dy, elevation, sums, walled, ax, ay):
     """Correct a^int (``ax``, ``ay``) of the particles ``rows`` at shores (module docstring).
 
-    ``sums`` holds their D, E and g M (columns 0-1, 2-3, 4-6, of
-    ``floodsph.sph.forces.internal_acceleration``); velocities u, v [m s-1]; ``bed`` is the
-    (n, 7) sample of ``floodsph.sph.bed.sample_bed`` (column 0, b_i [m]); ``elevation`` the
-    node-centred DEM grid with spacings dx, dy [m]; particles flagged in ``walled`` are left
-    alone (their force is the wall's, ``floodsph.walls.shadow.balance_walls``).
+    ``sums`` holds their D, E and g M (``floodsph.sph.sums``); velocities u, v [m s-1];
+    ``bed`` is the sample of ``floodsph.sph.bed.sample_bed`` (column ``BED``, b_i [m]);
+    ``elevation`` the node-centred DEM grid with spacings dx, dy [m]; particles flagged in
+    ``walled`` are left alone (their force is the wall's,
+    ``floodsph.walls.shadow.balance_walls``).
     """
     ny, nx = elevation.shape
     for k in prange(rows.shape[0]):
         i = rows[k]
         if walled[i]:
             continue
-        ex = sums[i, 2]
-        ey = sums[i, 3]
+        ex = sums[i, E_X]
+        ey = sums[i, E_Y]
         e = math.sqrt(ex * ex + ey * ey)
         if e * h[i] < FULL_SUPPORT * GRAVITY:
             continue
@@ -96,7 +97,7 @@ def balance_shores(rows, x, y, u, v, rho, h, bed, dx, dy, elevation, sums, walle
         reach = h[i] / e
         b_out = elevation_at(x[i] + reach * ex, y[i] + reach * ey, dx, dy, elevation, nx, ny)
         ve = max(u[i] * ex + v[i] * ey, 0.0) / e
-        cut = d - min(max(d + 0.5 * ve * ve / GRAVITY + bed[i, 0] - b_out, 0.0), d)
+        cut = d - min(max(d + 0.5 * ve * ve / GRAVITY + bed[i, BED] - b_out, 0.0), d)
         if cut <= 0.0:
             continue
         ax[i] -= cut * ex
@@ -105,7 +106,7 @@ def balance_shores(rows, x, y, u, v, rho, h, bed, dx, dy, elevation, sums, walle
         if det < DET_MIN:
             continue
         gamma = cut / d
-        dpx = sums[i, 0]
-        dpy = sums[i, 1]
+        dpx = sums[i, D_X]
+        dpy = sums[i, D_Y]
         ax[i] += gamma * ((myy * dpx - mxy * dpy) / det - dpx)
         ay[i] += gamma * ((mxx * dpy - mxy * dpx) / det - dpy)

@@ -24,11 +24,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from floodsph.inputs.initial_water import particles_at
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
 from floodsph.scenario.numerics import Numerics, Refinement
-from floodsph.verification.cases import exact
+from floodsph.verification import exact, metrics
 
 
 @dataclass(frozen=True)
@@ -116,7 +116,7 @@ def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **nume
                      v=v(xw, yw) if callable(v) else v, d_min=1e-3)
     num = Numerics(particle_spacing_m=dx, kappa=kappa,
                    **{"refinement": Refinement.NONE, **numerics})
-    return FloodModel(terrain, p, num, refiner=Refiner.of(num))
+    return set_up_model(terrain, p, num, refiner=Refiner.of(num))
 
 
 def _run(model, t_end):
@@ -173,9 +173,9 @@ def ritter(dx: float, kappa: float = Numerics.kappa, **numerics) -> CaseResult:
     model's ``Numerics`` (``refinement`` default: ``Refinement.NONE``, uniform resolution)."""
     c = RITTER
     model, v0, wall, pst, pairs, xq, d, d_ex = _dam_break(c, dx, kappa, numerics)
-    front = exact.front_position(xq, d, 0.1) - exact.front_position(xq, d_ex, 0.1)
+    front = metrics.front_position(xq, d, 0.1) - metrics.front_position(xq, d_ex, 0.1)
     return CaseResult("ritter", dx, model.particles.n, model.steps, wall, pst, pairs,
-                      exact.l1_relative(d, d_ex), float(front),
+                      metrics.l1_relative(d, d_ex), float(front),
                       abs(model.volume() - v0) / v0, *_labels(model),
                       Profile(xq, d, d_ex, "mean of four lines along the channel"))
 
@@ -189,7 +189,7 @@ def stoker(dx: float, kappa: float = Numerics.kappa, **numerics) -> CaseResult:
     bore = xq[right][d[right] > 0.5 * (d_m + c.d_right)].max()
     front = bore - exact.stoker_bore_position(c.t_end, c.d_left, c.d_right, x_dam=c.x_dam)
     return CaseResult("stoker", dx, model.particles.n, model.steps, wall, pst, pairs,
-                      exact.l1_relative(d, d_ex), float(front),
+                      metrics.l1_relative(d, d_ex), float(front),
                       abs(model.volume() - v0) / v0, *_labels(model),
                       Profile(xq, d, d_ex, "mean of four lines along the channel"))
 

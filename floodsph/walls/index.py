@@ -11,12 +11,27 @@ have none and pay nothing.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
 from scipy import ndimage
 
 from floodsph.walls.geometry import segment_distance
+
+
+class NearWalls(NamedTuple):
+    """CSR lists of each particle's near wall segments and of its wall corners.
+
+    Particle i's near segments are ``wseg[wstart[i]:wstart[i + 1]]`` (rows of the model's
+    ``seg``), and the pairs of them that meet at a right angle (the corners that make double
+    images) are the rows ``cpair[cstart[i]:cstart[i + 1]]`` ((k, 2) segment indices).
+    """
+
+    wstart: np.ndarray
+    wseg: np.ndarray
+    cstart: np.ndarray
+    cpair: np.ndarray
 
 
 class WallIndex:
@@ -70,20 +85,17 @@ class WallIndex:
         self.width = 16  # row width of the near-segment scan, widened when a row overflows
 
     def near_lists(self, x, y, h, nstart, nbr, reach):
-        """CSR lists of the segments within each particle's reach, and of its wall corners.
-
-        Returns (wstart, wseg, cstart, cpair): particle i's near segments are
-        ``wseg[wstart[i]:wstart[i + 1]]``, and the pairs of them that meet at a right
-        angle (the corners that make double images) are the rows ``cpair[cstart[i]:cstart[i + 1]]``.
-        The radius of particle i is reach * max(h_i, max_j h_j) over its neighbours j, so a
-        wall between i and any neighbour is always in i's list (pair blocking is symmetric).
+        """The :class:`NearWalls` lists of the segments within each particle's reach, and of its
+        wall corners. The radius of particle i is reach * max(h_i, max_j h_j) over its
+        neighbours j, so a wall between i and any neighbour is always in i's list (pair
+        blocking is symmetric).
         """
         n = x.shape[0]
         wstart = np.zeros(n + 1, dtype=np.int64)
         cstart = np.zeros(n + 1, dtype=np.int64)
         if self.seg.shape[0] == 0 or n == 0:
-            return (wstart, np.zeros(0, dtype=np.int64), cstart,
-                    np.zeros((0, 2), dtype=np.int64))
+            return NearWalls(wstart, np.zeros(0, dtype=np.int64), cstart,
+                             np.zeros((0, 2), dtype=np.int64))
         args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items, self.clear,
                 self.xmin, self.ymin, self.lv_bucket, self.lv_nbx, self.lv_nby, self.lv_off,
                 float(h.max()))
@@ -103,7 +115,7 @@ class WallIndex:
         np.cumsum(cstart, out=cstart)
         cpair = np.empty((cstart[-1], 2), dtype=np.int64)
         _corner_scan(*corners, cpair, True)
-        return wstart, wseg, cstart, cpair
+        return NearWalls(wstart, wseg, cstart, cpair)
 
 
 def _bucket_lists(seg: np.ndarray, xmin: float, ymin: float, bucket: float, nbx: int,

@@ -39,7 +39,7 @@ def test_the_resolved_scenario_writes_every_numerics_key_given_or_defaulted_and_
 def test_the_scenarios_values_reach_the_model_under_their_own_names(write_scenario):
     """What the user writes is what the solver uses: no second set of defaults on the way."""
     from floodsph.inputs.prepare import prepare_inputs
-    from floodsph.run.pipeline import build_model
+    from floodsph.model.from_scenario import build_model
     from floodsph.sph import forces
 
     text = BASE_SCENARIO.replace(
@@ -56,7 +56,7 @@ def test_the_scenarios_values_reach_the_model_under_their_own_names(write_scenar
 
 def test_the_dem_cell_size_fills_in_a_missing_particle_spacing(write_scenario):
     from floodsph.inputs.prepare import prepare_inputs
-    from floodsph.run.pipeline import build_model
+    from floodsph.model.from_scenario import build_model
 
     scenario = load_scenario(write_scenario(BASE_SCENARIO.replace(
         "particle_spacing_m = 10.0\n", "")))

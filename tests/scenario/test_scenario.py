@@ -210,7 +210,7 @@ def test_a_bad_hydrograph_is_refused_with_the_inputs_naming_file_key_and_line(wr
 
 def test_refinement_thresholds_reach_the_refiner(write_scenario):
     from floodsph.inputs.prepare import prepare_inputs
-    from floodsph.run.pipeline import build_model
+    from floodsph.model.from_scenario import build_model
 
     text = BASE_SCENARIO.replace(
         'refinement = "none"',
@@ -229,7 +229,7 @@ def test_refinement_thresholds_reach_the_refiner(write_scenario):
 def test_closed_sides_are_walls_and_the_other_sides_open(write_scenario):
     from floodsph.boundaries import OpenEdges
     from floodsph.inputs.prepare import prepare_inputs
-    from floodsph.run.pipeline import build_model
+    from floodsph.model.from_scenario import build_model
 
     text = BASE_SCENARIO.replace('edges = "closed"', 'edges = "open"\nclosed_sides = ["west"]')
     scenario = load_scenario(write_scenario(text))

@@ -3,7 +3,7 @@
 import numpy as np
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
@@ -26,7 +26,7 @@ def stretched_lake(stretch, slope, dx=10.0, kappa=Numerics.kappa, patch=None):
     p = ParticleSet(x.size)
     p.append(x=x, y=y, m=RHO_WATER * d * stretch * dx * dx, rho=RHO_WATER * d,
              h=np.full(x.size, kappa * dx * np.sqrt(stretch)))
-    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx, kappa=kappa))
+    return set_up_model(terrain, p, Numerics(particle_spacing_m=dx, kappa=kappa))
 
 
 def test_the_pressure_force_on_a_stretched_lattice_is_the_depth_gradient():

@@ -6,7 +6,7 @@ from sph_cases import model_on
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.scenario.numerics import TimeStepping
-from floodsph.sph import forces
+from floodsph.sph import time_step
 
 N, D = 0.05, 0.2  # Manning n [s m-1/3], depth [m]
 
@@ -23,7 +23,7 @@ def test_a_steady_kick_and_friction_settle_at_the_manning_speed_for_any_step(bet
     u = 0.0
     for _ in range(2000):
         u += dt * a
-        u *= forces.friction_factor(u, 0.0, RHO_WATER * D, N, dt, 0.01)
+        u *= time_step.friction_factor(u, 0.0, RHO_WATER * D, N, dt, 0.01)
     assert u == pytest.approx(u_e, rel=1e-9)
 
 

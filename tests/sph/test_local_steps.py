@@ -7,12 +7,12 @@ import pytest
 from sph_cases import model_on, particles_with_depth, run_until
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics, Refinement, TimeStepping
 from floodsph.sph import local_steps
 from floodsph.sph.neighbours import NeighbourList
-from floodsph.verification.cases import cases
+from floodsph.verification import cases
 
 
 def test_strides_are_the_largest_powers_of_two_within_each_particles_own_cfl_step():
@@ -88,7 +88,7 @@ def test_local_steps_conserve_momentum_to_the_order_of_the_step():
     p = particles_with_depth(x, y, d, 8.0, 1.3, u=rng.normal(0, 1, x.size) + 2.0,
                              v=rng.normal(0, 1, x.size) - 1.0)
     numerics = Numerics(particle_spacing_m=8.0, kappa=1.3, time_stepping=TimeStepping.LOCAL)
-    model = FloodModel(terrain, p, numerics, closed_edges=False)
+    model = set_up_model(terrain, p, numerics, closed_edges=False)
     mom0 = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     run_until(model, 20.0)
     assert model.volume_out == 0.0

@@ -4,6 +4,7 @@ import numpy as np
 from sph_cases import model_on, run_until
 
 from floodsph.sph import forces
+from floodsph.sph.sums import SUMS
 
 SLOPE = 0.03
 
@@ -15,7 +16,7 @@ def variational_acceleration(model):
     forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                  p.kxx, p.kxy, p.kyy, model.nl.start, model.nl.nbr, model.blocked,
                                  model.wdist, *model.walls_near, model.seg, model.scheme,
-                                 np.empty((p.n, forces.SUMS)), ax, ay, divv)
+                                 np.empty((p.n, SUMS)), ax, ay, divv)
     forces.add_bed_acceleration(model.nl.rows, p.u, p.v, model.bed, model.numerics.max_slope,
                                 ax, ay)
     return ax, ay
@@ -54,7 +55,7 @@ def test_a_front_running_downhill_keeps_its_push():
     assert not dam_break(lambda x, y: 0 * x).shores
     model = dam_break(lambda x, y: -1e-3 * x)
     run_until(model, 10.0)
-    model._forces()
+    model.evaluate_forces()
     p = model.particles
     ax, ay = variational_acceleration(model)
     front = p.x > p.x.max() - 2.0 * p.h.max()

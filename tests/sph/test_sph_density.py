@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from sph_cases import lattice, model_on, particles_with_depth
 
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
 from floodsph.sph import density
@@ -36,7 +36,7 @@ def test_newton_converges_in_few_iterations_from_a_perturbed_guess():
     terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 100), (0, 100), 10.0)
     x, y = lattice(0, 100, 0, 100, 2.0)
     p = particles_with_depth(x, y, np.full(x.size, 3.0), 2.0, 1.3)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=2.0, kappa=1.3))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=2.0, kappa=1.3))
     p.rho[:] *= 1.05  # a guess 5 % off, as after a long step
     p.h[:] = p.h0 * np.sqrt(p.rho0 / p.rho)
     iters, bad, _, _ = solve(model, tol=1e-6)
@@ -49,7 +49,7 @@ def test_newton_converges_in_few_iterations_from_a_perturbed_guess():
 def test_isolated_particle_has_bounded_h():
     terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 1000), (0, 1000), 10.0)
     p = particles_with_depth(np.array([500.0]), np.array([500.0]), np.array([1.0]), 5.0, 1.3)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=5.0, kappa=1.3, h_ratio=4.0))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=5.0, kappa=1.3, h_ratio=4.0))
     assert model.particles.h[0] == pytest.approx(4.0 * 6.5)
     assert np.isfinite(model.particles.rho[0]) and model.particles.rho[0] > 0
     # no neighbour in its support (alpha = 0): the uncorrected force, no NaN in div v
@@ -68,7 +68,7 @@ def test_isolated_particle_left_compressed_spreads_again():
 
     terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 1000), (0, 1000), 10.0)
     p = particles_with_depth(np.array([500.0]), np.array([500.0]), np.array([1.0]), 5.0, 1.3)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=5.0, kappa=1.3, h_ratio=10.0))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=5.0, kappa=1.3, h_ratio=10.0))
     p.h[0] = p.h0[0] / 10.0
     p.rho[0] = p.m[0] * SIGMA_2D / p.h[0] ** 2
     dt0 = model.stable_dt()
@@ -86,12 +86,12 @@ def test_capped_solve_keeps_the_lists_valid_and_catches_up_after_a_rebuild():
     terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 100), (0, 100), 10.0)
     x, y = lattice(0, 100, 0, 100, 2.0)
     p = particles_with_depth(x, y, np.full(x.size, 3.0), 2.0, 1.3)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=2.0, kappa=1.3))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=2.0, kappa=1.3))
     i = p.n // 2 + 25
     p.rho[i] *= 1.0 / 0.7**2
     p.h[i] *= 0.7
-    model._neighbours(force=True)
-    model._blocked_pairs()
+    model.update_lists(force=True)
+    model.block_pairs()
     cap = model.nl.h_cap(p.x, p.y)[i]
     _, bad, capped, _ = solve(model, cap=True)
     assert capped == 1 and bad == 0
@@ -100,8 +100,8 @@ def test_capped_solve_keeps_the_lists_valid_and_catches_up_after_a_rebuild():
     rho_at_cap, _ = summation(model, i)
     assert p.rho[i] == pytest.approx(rho_at_cap, rel=1e-12)
     for _ in range(5):
-        model._neighbours(force=True)
-        model._blocked_pairs()
+        model.update_lists(force=True)
+        model.block_pairs()
         solve(model, cap=True)
     assert p.rho[i] / 3000.0 == pytest.approx(1.0, abs=2e-3)
 
@@ -115,15 +115,15 @@ def test_a_heavy_neighbour_brought_close_does_not_collapse_h_in_a_time_step():
     terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 100), (0, 100), 10.0)
     x, y = lattice(0, 100, 0, 100, 5.0)
     p = particles_with_depth(x, y, np.full(x.size, 0.5), 5.0, 1.3)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=5.0, kappa=1.3))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=5.0, kappa=1.3))
     i = int(np.argmin(np.hypot(p.x - 52.5, p.y - 52.5)))
     j = int(np.argmin(np.hypot(p.x - 57.5, p.y - 52.5)))
     h_guess = p.h[i]
     p.x[j] = p.x[i] + 0.05 * h_guess
     p.y[j] = p.y[i]
     p.m[j] *= 10.0
-    model._neighbours(force=True)
-    model._blocked_pairs()
+    model.update_lists(force=True)
+    model.block_pairs()
     _, bad, capped, held = solve(model, cap=True)
     assert bad == 0 and capped == 0 and held >= 1
     assert p.h[i] == pytest.approx(density.H_SHRINK_MIN * h_guess, rel=1e-12)

@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 from sph_cases import model_on, particles_with_depth, run_until
 
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
 from floodsph.scenario.numerics import Numerics
+from floodsph.sph.sums import SUMS
 
 
 def test_closed_box_conserves_mass_and_keeps_every_particle_inside():
@@ -32,7 +33,8 @@ def test_momentum_changes_only_through_external_forces():
     d = 2.0 + 0.5 * rng.random(x.size)
     p = particles_with_depth(x, y, d, 8.0, 1.3, u=rng.normal(0, 1, x.size) + 2.0,
                              v=rng.normal(0, 1, x.size) - 1.0)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=8.0, kappa=1.3), closed_edges=False)
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=8.0, kappa=1.3),
+                         closed_edges=False)
     mom0 = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     scale = (p.m * np.hypot(p.u, p.v)).sum()
     run_until(model, 20.0)
@@ -233,8 +235,8 @@ def test_segments_beyond_reach_are_skipped_without_changing_density_or_forces():
                      lambda x, y: np.where(x < 60, 2.0, 0.0), 4.0, walls=[building])
     run_until(model, 20.0)
     p = model.particles
-    model._neighbours(force=True)
-    model._blocked_pairs()
+    model.update_lists(force=True)
+    model.block_pairs()
     wstart, wseg, cstart, cpair = model.walls_near
     beyond = model.wdist >= 2.0 * np.repeat(p.h, np.diff(wstart))
     assert p.h.max() > 2.0 * 1.3 * 4.0 and beyond.mean() > 0.3
@@ -247,7 +249,7 @@ def test_segments_beyond_reach_are_skipped_without_changing_density_or_forces():
         forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                      p.kxx, p.kxy, p.kyy, model.nl.start, model.nl.nbr,
                                      model.blocked, wdist, *model.walls_near, model.seg,
-                                     model.scheme, np.empty((p.n, forces.SUMS)), *acc)
+                                     model.scheme, np.empty((p.n, SUMS)), *acc)
         return np.array(rho), acc
 
     rho, acc = results(model.wdist)

@@ -14,10 +14,7 @@ import numpy as np
 import pytest
 
 from floodsph.verification.exact import (
-    front_position,
-    l1_relative,
     lake_at_rest,
-    observed_order,
     ritter,
     ritter_front,
     stoker,
@@ -27,6 +24,7 @@ from floodsph.verification.exact import (
     thacker_planar,
     thacker_shoreline,
 )
+from floodsph.verification.metrics import front_position, l1_relative, observed_order
 
 G = 9.81
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from floodsph.scenario.numerics import Refinement
-from floodsph.verification.cases import cases, exact
+from floodsph.verification import cases, metrics
 
 
 def test_ritter_dam_break_coarse():
@@ -57,7 +57,7 @@ def test_ritter_convergence_meets_targets():
     results = [cases.ritter(dx) for dx in (10.0, 5.0, 2.5)]
     errors = [r.l1 for r in results]
     assert results[1].l1 <= 0.015
-    assert exact.observed_order(errors, [10.0, 5.0, 2.5]) >= 0.8
+    assert metrics.observed_order(errors, [10.0, 5.0, 2.5]) >= 0.8
     assert all(abs(r.front_error_m) <= 2 * r.spacing for r in results)
     assert np.all(np.diff(errors) < 0)
 
@@ -71,7 +71,7 @@ def test_refined_ritter_convergence_meets_targets():
     results = [cases.ritter(dx, refinement=Refinement.SPLIT_COALESCE) for dx in (10.0, 5.0, 2.5)]
     errors = [r.l1 for r in results]
     assert results[1].l1 <= 0.015
-    assert exact.observed_order(errors, [10.0, 5.0, 2.5]) >= 0.8
+    assert metrics.observed_order(errors, [10.0, 5.0, 2.5]) >= 0.8
     assert all(abs(r.front_error_m) <= 2 * r.spacing for r in results)
 
 

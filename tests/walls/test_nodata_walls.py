@@ -6,7 +6,7 @@ from scipy import ndimage
 
 from floodsph.constants import RHO_WATER
 from floodsph.inputs.initial_water import seed_particles, wet_cells
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
 from floodsph.walls import nodata as nw
@@ -164,7 +164,7 @@ def lake_model(slivers=True):
     wet = wet_cells(terrain, walled=slivers)
     p = seed_particles(terrain, np.where(wet, 2.0, 0.0), 5.0, Numerics.kappa, wet=wet)
     volume = float(np.sum(p.m[:p.n]) / RHO_WATER)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=5.0), closed_edges=True)
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=5.0), closed_edges=True)
     return terrain, model, volume
 
 

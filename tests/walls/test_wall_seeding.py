@@ -9,7 +9,7 @@ from conftest import load_workflow
 from sph_cases import lattice, model_on, run_until
 
 from floodsph.constants import RHO_WATER
-from floodsph.model.flood_model import FloodModel
+from floodsph.model import wall_seeds
 from floodsph.scenario.numerics import Numerics
 from floodsph.walls import seeding as wall_seeding
 from floodsph.walls.geometry import segments_from_polylines
@@ -90,7 +90,7 @@ def test_seeds_that_need_no_settling_leave_the_set_up_as_it_was(monkeypatch):
 
     model = build()
     assert model.counters["seeds_settled"] > 500 and model.counters["settle_steps"] == 0
-    monkeypatch.setattr(FloodModel, "_wall_seeds", lambda self, rho: np.zeros(0, np.int64))
+    monkeypatch.setattr(wall_seeds, "wall_seeds", lambda model, rho: np.zeros(0, np.int64))
     unsettled = build()
     assert unsettled.counters["seeds_settled"] == 0
     for field in ("rho", "h", "hgrow", "ax", "ay", "kxx", "kxy", "kyy"):
@@ -111,8 +111,8 @@ def test_seeds_whose_support_reaches_dry_ground_are_not_enclosed():
     index = WallIndex(seg, (0.0, 0.0, 200.0, 200.0), bucket=2.0 * h)
     n = x.size
     reach = wall_seeding.ENCLOSURE * h
-    wstart, wseg = index.near_lists(x, y, np.full(n, h), np.zeros(n + 1, dtype=np.int64),
-                                    np.zeros(0, dtype=np.int64), wall_seeding.ENCLOSURE)[:2]
+    wstart, wseg, _, _ = index.near_lists(x, y, np.full(n, h), np.zeros(n + 1, dtype=np.int64),
+                                          np.zeros(0, dtype=np.int64), wall_seeding.ENCLOSURE)
     near = np.flatnonzero(np.diff(wstart) > 0)
     enclosed = wall_seeding.enclosed_seeds(x, y, np.full(n, reach), near, dx, wstart, wseg, seg)
     inner = (y[near] + dx / 2 >= reach) & (100.0 + dx / 2 - y[near] >= reach)  # first dry nodes

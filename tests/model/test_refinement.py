@@ -12,14 +12,14 @@ import pytest
 
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
-from floodsph.model.flood_model import FloodModel
+from floodsph.model.builder import set_up_model
 from floodsph.model.refinement import Refiner
 from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
 from floodsph.scenario.numerics import SMOOTHING_EXCESS, Numerics, NumericsError, Refinement
 from floodsph.sph import refine
 from floodsph.sph.kernels import SIGMA_2D, w_cubic
-from floodsph.verification.cases import cases
+from floodsph.verification import cases
 from tests.sph_cases import lattice, model_on, particles_with_depth
 
 
@@ -38,7 +38,7 @@ def jittered_pond(depth, size=30.0, dx=1.0, jitter=0.15, seed=1, u=0.0, v=0.0):
     uu = u(x, y) if callable(u) else u
     vv = v(x, y) if callable(v) else v
     p = particles_with_depth(x, y, d, dx, 1.3, u=uu, v=vv)
-    return FloodModel(terrain, p, Numerics(particle_spacing_m=dx, kappa=1.3))
+    return set_up_model(terrain, p, Numerics(particle_spacing_m=dx, kappa=1.3))
 
 
 def make_refiner(spacing: float, **settings) -> Refiner:
@@ -134,7 +134,7 @@ def test_no_split_across_a_wall_or_below_d_min_or_beyond_max_level():
     wall_x = 10.3  # particles at x = 9.5 and 10.5 sit 0.8 and 0.2 m from the wall
     d = np.where(y < 10.0, 1.0, 0.005)  # the north half is thinner than d_min = 0.01 m
     p = particles_with_depth(x, y, d, 1.0, 1.3)
-    model = FloodModel(terrain, p, Numerics(particle_spacing_m=1.0, kappa=1.3),
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=1.0, kappa=1.3),
                        walls=[np.array([[wall_x, 0.0], [wall_x, 20.0]])])
     p = model.particles
     refiner = split_only(refine_max_level=1)
@@ -229,7 +229,7 @@ def pond_with_small_particles(fraction, at):
     p.m[q.n:] *= fraction
     p.h[q.n:] = p.h0[q.n:] = 1.3 * math.sqrt(fraction)  # the lattice h of their area
     p.u[q.n:], p.v[q.n:] = 0.2, -0.1
-    model = FloodModel(base.terrain, p, Numerics(particle_spacing_m=1.0, kappa=1.3))
+    model = set_up_model(base.terrain, p, Numerics(particle_spacing_m=1.0, kappa=1.3))
     small = np.flatnonzero(np.isin(model.particles.pid, np.arange(q.n, p.n)))
     return model, small
 

@@ -1,0 +1,58 @@
+"""The model of a scenario: its numerics, walls, closed sides and open boundaries, set up.
+
+The bridge between the scenario (``floodsph.scenario``) with its prepared inputs
+(``floodsph.inputs.prepare.Inputs``) and ``floodsph.model.builder.set_up_model``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from floodsph.boundaries import Inflow, Sink
+from floodsph.model.builder import set_up_model
+from floodsph.model.refinement import Refiner
+from floodsph.scenario.config import Edges, Scenario
+
+
+def build_model(scenario: Scenario, inputs):
+    """The FloodModel of ``scenario`` from prepared inputs, with its open boundaries.
+
+    The model's numerics are the scenario's, with ``particle_spacing_m`` the spacing the
+    particles were seeded at (the DEM cell size when the scenario gives none).
+    """
+    numerics = replace(scenario.numerics, particle_spacing_m=inputs.spacing_m)
+    return set_up_model(
+        inputs.terrain,
+        inputs.particles,
+        numerics,
+        walls=inputs.walls,
+        closed_edges=_closed_edges(scenario.terrain),
+        boundaries=open_boundaries(scenario, inputs, numerics),
+        refiner=Refiner.of(numerics),
+    )
+
+
+def _closed_edges(terrain) -> bool | tuple[str, ...]:
+    """``set_up_model(closed_edges=...)``: True, False, or the sides kept closed."""
+    if terrain.edges is Edges.CLOSED:
+        return True
+    return terrain.closed_sides or False
+
+
+def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
+    """The ``[[inflows]]`` sections and ``[[sinks]]`` polygons (``inputs.sinks``, inline or
+    from vector files) as model boundaries."""
+    terrain = inputs.terrain
+    source = scenario.path.name
+    out = []
+    for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,
+                                                 strict=True)):
+        line = np.column_stack(terrain.to_local(*np.asarray(inflow.line, dtype=np.float64).T))
+        out.append(Inflow(line, hydrograph, numerics.particle_spacing_m, numerics.kappa, terrain,
+                          direction=inflow.direction, name=f"{source}: inflows[{i}]"))
+    reach = 4.0 * numerics.kappa * numerics.particle_spacing_m
+    for polygon in inputs.sinks:
+        out.append(Sink(polygon, terrain, reach))
+    return out
