@@ -43,15 +43,40 @@ DEPTH_M = 10.0
 """Depth of the still water behind the dam [m]."""
 
 
+LOCATIONS = {
+    "set_up_model": (("floodsph.model.builder", "set_up_model"), ("floodsph.model", "FloodModel")),
+    "ParticleSet": (("floodsph.model.particles", "ParticleSet"),
+                    ("floodsph.particles", "ParticleSet")),
+    "Terrain": (("floodsph.model.terrain", "Terrain"), ("floodsph.terrain", "Terrain")),
+    "Numerics": (("floodsph.scenario.numerics", "Numerics"), ("floodsph.numerics", "Numerics")),
+    "set_threads": (("floodsph.run.pipeline", "set_threads"), ("floodsph.run", "set_threads")),
+    "StageTimer": (("floodsph.model.stage_timer", "StageTimer"),
+                   ("floodsph.stage_timer", "StageTimer")),
+}
+"""Where each piece the worker uses lives: in this layout, then in the flat layout of the
+commits before the package's folders (so that ``--compare`` reaches back across it)."""
+
+
+def piece(name: str):
+    """The object ``name`` of :data:`LOCATIONS` from the floodsph being measured."""
+    import importlib
+
+    for module, attribute in LOCATIONS[name]:
+        try:
+            return getattr(importlib.import_module(module), attribute)
+        except (ImportError, AttributeError):
+            continue
+    raise ImportError(f"step_cost: this floodsph has no {name}")
+
+
 def dam_break(spacing: float):
     """The FloodModel of the dam break at ``spacing`` [m] (module docstring), built from the
-    public pieces only (``Terrain``, ``ParticleSet``, ``Numerics``), so that any checkout
-    builds the same case."""
+    public pieces only (``Terrain``, ``ParticleSet``, ``Numerics``, the model's set-up), so
+    that any checkout builds the same case."""
     from floodsph.constants import RHO_WATER
-    from floodsph.model.builder import set_up_model
-    from floodsph.model.particles import ParticleSet
-    from floodsph.model.terrain import Terrain
-    from floodsph.scenario.numerics import Numerics
+
+    set_up_model, ParticleSet, Terrain, Numerics = (
+        piece(name) for name in ("set_up_model", "ParticleSet", "Terrain", "Numerics"))
 
     terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0.0, 2000.0), (0.0, 100.0), 10.0)
     x1 = np.arange(spacing / 2, 1000.0, spacing)
@@ -74,9 +99,7 @@ def measure(spacing: float, steps: int, warmup: int) -> dict:
         model.step()
     timer = None
     if hasattr(model, "stage_timer"):  # else a checkout from before the stage timer
-        from floodsph.model.stage_timer import StageTimer
-
-        timer = model.stage_timer = StageTimer()
+        timer = model.stage_timer = piece("StageTimer")()
     updates = model.counters["particle_updates"]
     t0 = time.perf_counter()
     for _ in range(steps):
@@ -94,13 +117,12 @@ def worker() -> int:
     """Serve measurements: one JSON request (spacing, steps, warmup) per stdin line, one JSON
     result per stdout line."""
     import floodsph
-    from floodsph.run.pipeline import set_threads
 
     root = Path(os.environ["PYTHONPATH"]).resolve()
     if not Path(floodsph.__file__).resolve().is_relative_to(root):
         raise SystemExit(f"step_cost worker: floodsph imported from {floodsph.__file__}, "
                          f"not from {root}")
-    set_threads(int(os.environ.get("STEP_COST_THREADS", "1")))
+    piece("set_threads")(int(os.environ.get("STEP_COST_THREADS", "1")))
     for line in sys.stdin:
         request = json.loads(line)
         print(json.dumps(measure(**request)), flush=True)

@@ -29,15 +29,13 @@ members are built (:mod:`floodsph.ensemble.members`), still before any member ru
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
 
 from floodsph.ensemble.distributions import OPTIONAL, PARAMETERS, Distribution, read_distribution
 from floodsph.ensemble.keys import KeyPath, KeyPathError
-from floodsph.errors import InputError
-from floodsph.scenario.schema import Reader, describe, is_number, join
+from floodsph.scenario.schema import Reader, describe, is_number, join, read_toml
 
 ENSEMBLE_KEYS = ("name", "base", "members", "sampling", "seed", "parameters", "output")
 OUTPUT_KEYS = ("depth_thresholds_m", "quantiles")
@@ -116,17 +114,8 @@ class EnsembleSpec:
 def load_ensemble(path: str | Path) -> EnsembleSpec:
     """Read and validate an ensemble TOML file (InputError naming the file and key)."""
     path = Path(path)
-    source = str(path)
-    if not path.is_file():
-        raise InputError(f"{source}: ensemble file not found")
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{source}: invalid TOML: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{source}: cannot read the ensemble file: {exc}") from None
-    return ensemble_from_dict(data, source=source, base_dir=path.resolve().parent)
+    data = read_toml(path, "ensemble")
+    return ensemble_from_dict(data, source=str(path), base_dir=path.resolve().parent)
 
 
 def ensemble_from_dict(data: dict, *, source: str, base_dir: Path) -> EnsembleSpec:

@@ -136,18 +136,12 @@ class Envelopes:
         self.t_last = float(t)
         self.updates += 1
 
-    def due(self, t: float) -> bool:
-        """True when no update has been made yet or ``interval_s`` has passed since the last."""
-        return self.t_last is None or t >= self.t_last + self.interval_s * (1.0 - 1e-9)
-
-    def record(self, model, force: bool = False) -> bool:
-        """Update from a FloodModel (``model.t``, ``model.particles``) if due; True if done."""
-        if not (force or self.due(model.t)):
-            return False
+    def record(self, model) -> None:
+        """Update from a FloodModel (``model.t``, ``model.particles``); the simulation's
+        schedule (``floodsph.simulation.recorders``) decides when."""
         p = model.particles
         dt = 0.0 if self.t_last is None else model.t - self.t_last
         self.update(model.t, dt, p.x, p.y, p.u, p.v, p.m, p.rho, p.h)
-        return True
 
     def maps(self) -> dict[str, np.ndarray]:
         """Copies of the maps by name (row 0 = south); float64 or uint8 for classes."""

@@ -107,17 +107,11 @@ class Gauges:
             self.rows.append(row)
         self.t_last = float(t)
 
-    def due(self, t: float) -> bool:
-        """True when nothing was sampled yet or ``interval_s`` has passed since."""
-        return self.t_last is None or t >= self.t_last + self.interval_s * (1.0 - 1e-9)
-
-    def record(self, model, force: bool = False) -> bool:
-        """Sample a FloodModel (``model.t``, ``model.particles``) if due; True if done."""
-        if not (force or self.due(model.t)):
-            return False
+    def record(self, model) -> None:
+        """Sample a FloodModel (``model.t``, ``model.particles``); the simulation's schedule
+        (``floodsph.simulation.recorders``) decides when."""
         q = model.particles
         self.sample(model.t, q.x, q.y, q.u, q.v, q.m, q.rho, q.h)
-        return True
 
     def write_csv(self, path) -> Path:
         """Write ``time_s, id, depth_m, level_m, speed_ms`` (mm / ms precision; ``nan`` = dry)."""

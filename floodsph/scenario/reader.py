@@ -9,7 +9,6 @@ the :class:`~floodsph.scenario.config.Scenario`.
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import fields
 from enum import Enum
 from pathlib import Path
@@ -17,7 +16,6 @@ from typing import TYPE_CHECKING
 
 from floodsph.checks.elevation import ELEVATION_LIMIT_M
 from floodsph.checks.roughness import N_STRICKLER, strickler_text
-from floodsph.errors import InputError
 from floodsph.scenario.config import (
     SIDES,
     TOP_KEYS,
@@ -35,7 +33,7 @@ from floodsph.scenario.config import (
 )
 from floodsph.scenario.numerics import SCENARIO_KEYS as NUMERICS_KEYS
 from floodsph.scenario.numerics import Numerics, NumericsError
-from floodsph.scenario.schema import Reader, describe, join
+from floodsph.scenario.schema import Reader, describe, join, read_toml
 
 if TYPE_CHECKING:
     from floodsph.breach.params import BreachParams
@@ -51,17 +49,8 @@ def load_scenario(path: str | Path) -> Scenario:
         key or value; the message names the file and the key path.
     """
     path = Path(path)
-    source = str(path)
-    if not path.is_file():
-        raise InputError(f"{source}: scenario file not found")
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{source}: invalid TOML: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{source}: cannot read the scenario file: {exc}") from None
-    return scenario_from_dict(data, source=source, base_dir=path.resolve().parent)
+    data = read_toml(path, "scenario")
+    return scenario_from_dict(data, source=str(path), base_dir=path.resolve().parent)
 
 
 def scenario_from_dict(data: dict, *, source: str, base_dir: Path) -> Scenario:

@@ -1,6 +1,6 @@
 """Typed readers for the scenario TOML: every check names the file and the key path.
 
-The scenario loader (``floodsph.scenario.config``) reads each table through these helpers so that
+The scenario reader (``floodsph.scenario.reader``) reads each table through these helpers so that
 every problem is reported the same way, before any work starts::
 
     scenario.toml: inflows[0].line: expected two [x, y] points, got 1
@@ -12,6 +12,7 @@ paths are resolved against. Key paths are built as ``table.key`` and ``array[i].
 from __future__ import annotations
 
 import math
+import tomllib
 from enum import Enum
 from pathlib import Path
 from typing import Any
@@ -27,6 +28,21 @@ LARGEST_VALUE = 1.0e12
 SI units comes near it (projected coordinates stay below 1e8 m, the largest reservoirs hold
 2e11 m3, 1e12 s is 30,000 years), while a value beyond it (1e308) overflows to infinity in
 the first product it enters."""
+
+
+def read_toml(path: Path, what: str) -> dict:
+    """The parsed TOML file ``path``, or one InputError naming it: missing (``what`` file not
+    found), invalid TOML (with line and column) or unreadable."""
+    source = str(path)
+    if not path.is_file():
+        raise InputError(f"{source}: {what} file not found")
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{source}: invalid TOML: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{source}: cannot read the {what} file: {exc}") from None
 
 
 def join(path: str, key: str | int) -> str:

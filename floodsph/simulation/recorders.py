@@ -77,10 +77,10 @@ class Recorders:
         return out
 
     def record_envelopes(self, sim) -> None:
-        self.envelopes.record(sim.model, force=True)
+        self.envelopes.record(sim.model)
 
     def record_gauges(self, sim) -> None:
-        self.gauges.record(sim.model, force=True)
+        self.gauges.record(sim.model)
 
     def record_snapshot(self, sim) -> None:
         from floodsph.output.rasterise import rasterise
