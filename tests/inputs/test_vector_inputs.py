@@ -13,7 +13,8 @@ from conftest import BASE_SCENARIO, CELL, CRS, NX, NY, RESERVOIR_VOLUME_M3, X0, 
 
 from floodsph.errors import InputError
 from floodsph.inputs.prepare import prepare_inputs
-from floodsph.scenario.reader import load_scenario, write_resolved
+from floodsph.scenario.reader import load_scenario
+from floodsph.scenario.writer import write_resolved
 
 TO_LONLAT = pyproj.Transformer.from_crs(CRS, "EPSG:4326", always_xy=True)
 
