@@ -34,7 +34,7 @@ from floodsph.sph.cells import CellGrid
 from floodsph.sph.neighbours import NeighbourList
 from floodsph.sph.sums import SUMS
 from floodsph.walls import shadow, sight
-from floodsph.walls.index import WallIndex
+from floodsph.walls.index import WallIndex, WallLists
 
 MAX_SEARCH_GROWTH = 2.0
 """Cap on the factor ``hgrow`` by which a particle's neighbour search is widened."""
@@ -320,18 +320,18 @@ class FloodModel:
         sight.blocked_pairs(self.nl.rows, p.x, p.y, self.nl.start, self.nl.nbr,
                               near.wstart, near.wseg, self.seg, self.blocked, self.wdist)
 
-    def _image_lists(self):
-        """The wall arguments (wdist, wstart, wseg, cstart, cpair) of the density and force
-        kernels: with ``wall_model = "integral"`` no segment makes images (its distance
-        infinite, no corners), and the walls act through ``floodsph.walls.shadow``."""
+    def wall_lists(self) -> WallLists:
+        """The walls as the density and force kernels take them: with ``wall_model =
+        "integral"`` no segment makes images (its distance infinite, no corners), and the
+        walls act through ``floodsph.walls.shadow``."""
         wstart, wseg, cstart, cpair = self.walls_near
         if not self.integral_walls:
-            return self.wdist, wstart, wseg, cstart, cpair
+            return WallLists(self.seg, self.wdist, wstart, wseg, cstart, cpair)
         if self._no_images[0] is not self.walls_near:  # once per build of the lists
-            self._no_images = (self.walls_near, np.full(wseg.shape[0], np.inf),
-                               np.zeros_like(cstart), cpair[:0])
-        _, far, no_corners, no_pairs = self._no_images
-        return far, wstart, wseg, no_corners, no_pairs
+            self._no_images = (self.walls_near, WallLists(
+                self.seg, np.full(wseg.shape[0], np.inf), wstart, wseg, np.zeros_like(cstart),
+                cpair[:0]))
+        return self._no_images[1]
 
     def _solve_density(self, settle: bool = False) -> None:
         """The depth-density solve.
@@ -350,9 +350,8 @@ class FloodModel:
         h_predicted = p.h.copy()
         for _ in range(SETTLE_ROUNDS if settle else 2):
             self.block_pairs()
-            wdist, *walls = self._image_lists()
             outcome = density.solve_density(
-                p, self.nl, self.blocked, wdist, walls, self.seg,
+                p, self.nl, self.blocked, self.wall_lists(),
                 tol=num.density_tol, max_iter=num.density_max_iter, h_ratio=num.h_ratio,
                 cap=not settle, integral=self.integral_walls, unmoved=self._nl_here)
             if settle and self.nl.covers(p.x, p.y, p.h):
@@ -382,8 +381,8 @@ class FloodModel:
             self.block_pairs()
         forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, p.kxx,
                                      p.kxy, p.kyy, self.nl.start, self.nl.nbr, self.blocked,
-                                     *self._image_lists(), self.seg, self.scheme,
-                                     self.pair_sums, p.ax, p.ay, p.divv)
+                                     self.wall_lists(), self.scheme, self.pair_sums, p.ax,
+                                     p.ay, p.divv)
         consistency.update_renormalisation(rows, p.h, self.pair_sums, self.shores, p.kxx, p.kxy,
                                            p.kyy)
         if self.walled.shape[0] != p.n:

@@ -78,17 +78,19 @@ def _corner(i, j, x, y, m, hi, seg, s1, s2):
 
 
 @njit(inline="always", cache=True)
-def summation(i, hi, x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart, cpair, seg):
+def summation(i, hi, x, y, m, nstart, nbr, blocked, walls):
     """Density summation (1) and alpha_i of particle i at smoothing length ``hi``.
 
     Returns (sum_j m_j W(r_ij, h_i), alpha_i), self and mirror images included; listed
     neighbours beyond the support 2 h_i are skipped (W = 0 there). Pairs flagged in
     ``blocked`` (:func:`floodsph.walls.sight.blocked_pairs`) are left out with their images.
-    A segment farther than 2 h_i from i (``wdist``, of the same function) makes no image
+    ``walls`` is the :class:`~floodsph.walls.index.WallLists` of the particles.
+    A segment farther than 2 h_i from i (``walls.wdist``) makes no image
     within the support, so its single images are skipped (the sum is unchanged).
     Images are summed segment by segment, each segment followed by the corners it opens
     (``cpair`` lists them in that order), so the sum does not depend on list order.
     """
+    seg, wdist, wstart, wseg, cstart, cpair = walls
     xi = x[i]
     yi = y[i]
     rsum = m[i] * w_cubic(0.0, hi)
@@ -157,8 +159,8 @@ def _h_of_rho(h0, rho0, rho, h_ratio):
 
 
 @njit(parallel=True, cache=True)
-def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, wstart, wseg,
-          cstart, cpair, seg, tol, max_iter, h_ratio, h_cap, h_shrink, integral, iters):
+def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, walls, tol, max_iter,
+          h_ratio, h_cap, h_shrink, integral, iters):
     """Newton-Raphson solve (1)-(3) of the particles ``rows``, in place (gather form).
 
     Only h_i changes the summation of particle i, so each particle iterates on its own to
@@ -189,10 +191,9 @@ def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, w
         held = h_rho < h_low
         h[i] = min(max(h_rho, h_low), h_cap[i])
         while it < max_iter and not capped and not held:
-            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
-                             cpair, seg)
+            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, walls)
             if integral:
-                s, a = wall_corrected(i, h[i], s, a, x, y, wstart, wseg, seg)
+                s, a = wall_corrected(i, h[i], s, a, x, y, walls.wstart, walls.wseg, walls.seg)
             alpha[i] = a
             it += 1
             res = rho[i] - s
@@ -210,10 +211,9 @@ def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, wdist, w
         if done:
             iters[i] = it
         else:
-            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, wdist, wstart, wseg, cstart,
-                             cpair, seg)
+            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, walls)
             if integral:
-                s, a = wall_corrected(i, h[i], s, a, x, y, wstart, wseg, seg)
+                s, a = wall_corrected(i, h[i], s, a, x, y, walls.wstart, walls.wseg, walls.seg)
             rho[i] = s
             alpha[i] = a
             iters[i] = 0 if capped else (max_iter + 1 if held else -it)
@@ -228,15 +228,13 @@ def predict(rho, h, divv, dt):
         h[i] *= 1.0 / math.sqrt(f)
 
 
-def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ratio=10.0,
-                  cap=False, integral=False, unmoved=False):
+def solve_density(p, nl, blocked, walls, tol=1e-3, max_iter=20, h_ratio=10.0, cap=False,
+                  integral=False, unmoved=False):
     """Solve (1)-(3) in place for the particles of ``p`` that ``nl`` lists (``nl.rows``).
 
     ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList;
-    ``blocked`` its pairs separated by a wall and ``wdist`` the distances to the near
-    segments (both from :func:`floodsph.walls.sight.blocked_pairs`); ``walls`` the near-wall
-    lists (wstart, wseg, cstart, cpair) of
-    :meth:`floodsph.walls.index.WallIndex.near_lists`; ``seg`` the wall segments.
+    ``blocked`` its pairs separated by a wall (:func:`floodsph.walls.sight.blocked_pairs`);
+    ``walls`` the :class:`~floodsph.walls.index.WallLists` of the particles.
     With ``cap`` (a time step), no h grows beyond what ``nl`` holds (:meth:`NeighbourList.h_cap`),
     so the lists stay valid through the solve, and none shrinks below ``H_SHRINK_MIN`` times its
     guess (see the module docstring); ``unmoved``: the particles are where ``nl`` was built.
@@ -247,8 +245,7 @@ def solve_density(p, nl, blocked, wdist, walls, seg, tol=1e-3, max_iter=20, h_ra
     iters = np.ones(p.n, dtype=np.int64)  # rows not solved count as converged
     h_cap = nl.h_cap(p.x, p.y, unmoved) if cap else np.full(p.n, np.inf)
     solve(nl.rows, p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked,
-          wdist, *walls, seg, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0,
-          integral, iters)
+          walls, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, integral, iters)
     return DensityOutcome(*_outcome(iters, max_iter))
 
 

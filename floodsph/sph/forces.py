@@ -156,15 +156,14 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, kj, image=False):
 
 @njit(parallel=True, cache=True)
 def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nstart, nbr, blocked,
-                          wdist, wstart, wseg, cstart, cpair, seg, scheme, sums, ax, ay, divv):
+                          walls, scheme, sums, ax, ay, divv):
     """a^int and div v of the particles ``rows`` (gather form), mirror images included.
 
     Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
     flagged in ``blocked`` (:func:`floodsph.walls.sight.blocked_pairs`) are left out with
     their images, and a segment's single images skip the neighbours j whose pair support
-    2 max(h_i, h_j) does not reach it (``wdist``, of the same function). The wall lists
-    (wstart, wseg, cstart, cpair) are those of
-    :meth:`floodsph.walls.index.WallIndex.near_lists`; images are summed segment by segment,
+    2 max(h_i, h_j) does not reach it (``walls.wdist``); ``walls`` is the
+    :class:`~floodsph.walls.index.WallLists` of the particles. Images are summed segment by segment,
     each followed by the corners it opens, as in the density summation.
 
     Row i of ``sums`` (n, ``floodsph.sph.sums.SUMS``) receives particle i's sums of
@@ -173,6 +172,7 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nst
     pressure renormalisation K (kxx, kxy, kyy) is the one the latter set from them at i's
     previous force evaluation.
     """
+    seg, wdist, wstart, wseg, cstart, cpair = walls
     coef = np.empty((x.shape[0], 7))
     pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, coef)
     for k in prange(rows.shape[0]):

@@ -34,6 +34,21 @@ class NearWalls(NamedTuple):
     cpair: np.ndarray
 
 
+class WallLists(NamedTuple):
+    """The walls near each particle, as the density and force kernels take them (one
+    argument): the segments ``seg`` ((k, 4): x0, y0, x1, y1 [m]), the :class:`NearWalls`
+    lists, and ``wdist`` [m], the distance from each listed particle to each of its listed
+    segments (``floodsph.walls.sight.blocked_pairs``; infinite for a segment that makes no
+    mirror image, as with ``wall_model = "integral"``)."""
+
+    seg: np.ndarray
+    wdist: np.ndarray
+    wstart: np.ndarray
+    wseg: np.ndarray
+    cstart: np.ndarray
+    cpair: np.ndarray
+
+
 class WallIndex:
     """Static buckets of wall segments for fast near-wall queries, on a pyramid of grids.
 

@@ -14,8 +14,8 @@ spacing from the last row: in Ritter's 100 m wide channel at a spacing of 10 / s
 north wall lies 3.6 m beyond it, and the dam break's L1 depth error was 1.83 % (0.96 % at
 5 m, where the wall is half a spacing away).
 
-When the model is set up (``FloodModel._settle_at_walls``), the seeds next to walls that are
-in still water and enclosed (below) are therefore
+When the model is set up (``floodsph.model.wall_seeds.settle_at_walls``), the seeds next
+to walls that are in still water and enclosed (below) are therefore
 
 1. settled: moved by a_i dt^2 / 2 per round, with dt the model's CFL step, along the
    acceleration as in a steepest descent of the SPH energy, with the other particles held and

@@ -12,15 +12,15 @@ from floodsph.sph import density
 
 def solve(model, **kwargs):
     """``density.solve_density`` on the model's particles, lists and walls."""
-    return density.solve_density(model.particles, model.nl, model.blocked, model.wdist,
-                                 model.walls_near, model.seg, **kwargs)
+    return density.solve_density(model.particles, model.nl, model.blocked, model.wall_lists(),
+                                 **kwargs)
 
 
 def summation(model, i):
     """(rho_i, alpha_i) of the density summation at particle i's current h."""
     p = model.particles
     return density.summation(i, p.h[i], p.x, p.y, p.m, model.nl.start, model.nl.nbr,
-                             model.blocked, model.wdist, *model.walls_near, model.seg)
+                             model.blocked, model.wall_lists())
 
 
 def test_uniform_lattice_in_closed_box_gives_exact_depth_everywhere():

@@ -154,7 +154,7 @@ def test_the_closer_a_particle_is_to_a_wall_the_harder_the_wall_pushes_it_back()
         k = np.flatnonzero(p.pid == pid)[0]
         p.y[k] = gap
         model.nl = None
-        model._interactions()
+        model.interactions()
         k = np.flatnonzero(p.pid == pid)[0]
         push.append(p.ay[k])
     assert np.all(np.diff(push) > 0.0) and push[0] > 0.0
@@ -242,14 +242,15 @@ def test_segments_beyond_reach_are_skipped_without_changing_density_or_forces():
     assert p.h.max() > 2.0 * 1.3 * 4.0 and beyond.mean() > 0.3
 
     def results(wdist):
+        walls = model.wall_lists()._replace(wdist=wdist)
         rho = [density.summation(i, p.h[i], p.x, p.y, p.m, model.nl.start, model.nl.nbr,
-                                 model.blocked, wdist, *model.walls_near, model.seg)
+                                 model.blocked, walls)
                for i in range(p.n)]
         acc = np.empty((3, p.n))
         forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                      p.kxx, p.kxy, p.kyy, model.nl.start, model.nl.nbr,
-                                     model.blocked, wdist, *model.walls_near, model.seg,
-                                     model.scheme, np.empty((p.n, SUMS)), *acc)
+                                     model.blocked, walls, model.scheme, np.empty((p.n, SUMS)),
+                                     *acc)
         return np.array(rho), acc
 
     rho, acc = results(model.wdist)
