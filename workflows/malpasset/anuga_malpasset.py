@@ -178,7 +178,9 @@ def run(folder: Path, out: Path, threads: int, end_time: float, gauge_interval: 
             "triangles": int(len(triangles)), "triangle_area_median_m2": float(np.median(areas)),
             "sim_time_s": float(domain.get_time()), "steps": int(steps), "threads": threads,
             "setup_s": setup_s, "wall_time_s": wall_s,
-            "volume_initial_m3": volume0, "volume_final_m3": float(domain.get_water_volume())}
+            "volume_initial_m3": volume0,
+            "volume_initial_land_m3": float(np.sum(areas * depth0 * (bed >= setup.SEA_LEVEL_M))),
+            "volume_final_m3": float(domain.get_water_volume())}
     (out / "run.json").write_text(json.dumps(info, indent=2) + "\n")
     return info
 
