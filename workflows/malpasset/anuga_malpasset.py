@@ -53,6 +53,8 @@ import versus_grid_code as grid_code  # noqa: E402
 NODES_NAME = "mesh_small_nodes.csv"
 TRIANGLES_NAME = "mesh_small_triangles.csv"
 GAUGE_HEADER = ("time_s", "id", "depth_m", "level_m", "speed_ms")
+PROGRESS_EVERY = 100
+"""A progress line every this many gauge samples."""
 DRY_M = 1e-3
 """A cell whose maximum depth never exceeds this [m] gets no maximum level (NaN)."""
 
@@ -149,6 +151,9 @@ def run(folder: Path, out: Path, threads: int, end_time: float, gauge_interval: 
     rows, steps = [], 0
     for t in domain.evolve(yieldstep=gauge_interval, finaltime=end_time):
         steps += domain.number_of_steps
+        if round(t / gauge_interval) % PROGRESS_EVERY == 0:
+            print(f"t = {t:g} s, {steps} steps, {time.perf_counter() - start:.0f} s wall",
+                  flush=True)
         stage = stage_q.centroid_values[gauge_tri]
         depth = stage - bed_q.centroid_values[gauge_tri]
         flux = np.hypot(xmom.centroid_values[gauge_tri], ymom.centroid_values[gauge_tri])
