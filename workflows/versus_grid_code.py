@@ -19,31 +19,40 @@ ANUGA set-up, one-to-one with the floodsph inputs (``floodsph.inputs.prepare.pre
 * ``[[inflows]]``: ``anuga.Inlet_operator`` along the inflow line (moved a quarter cell inside
   the domain when it lies on the border) with Q(t) from the same hydrograph;
 * maximum depth: ``Collect_max_quantities_operator`` (every step) together with the initial
-  depth, then the mean of the four triangles of each DEM cell: a GeoTIFF on the DEM grid.
+  depth, then the mean of the four triangles of each DEM cell: a GeoTIFF on the DEM grid;
+* ``[gauges]``: depth, level and speed of the triangle holding each gauge (centroid values)
+  every ``interval_s``, in floodsph's ``gauges.csv`` layout.
 
 ``[[walls]]`` drawn along the DEM border (covering a whole side, inflow openings aside) make
 that side reflective, as in EA Test 4; other walls and ``[[sinks]]`` have no translation here:
 such scenarios are refused.
 
 Writes into the results folder: per scenario ``<name>/floodsph/`` (the run folder),
-``<name>/anuga_max_depth.tif``, ``<name>/comparison/`` (``floodsph compare`` outputs) and
-``<name>/max_depth_side_by_side.png`` (floodsph, ANUGA, difference); and one row per scenario in
+``<name>/anuga_max_depth.tif``, ``<name>/anuga_gauges.csv`` (with ``[gauges]``),
+``<name>/anuga_run.json`` (ANUGA's cost and volumes), ``<name>/comparison/`` (``floodsph
+compare`` outputs) and ``<name>/max_depth_side_by_side.png`` (floodsph, ANUGA, difference); and
+one row per scenario in
 ``versus_grid_code.csv``: wall times of both codes (same thread count, default 1: on a machine
 shared with other jobs, OpenMP threads waiting for a busy core make multi-thread timings
 erratic; floodsph's kernels are compiled by a 2-step warm-up run beforehand), their ratio, CSI
 and depth RMSE/bias. floodsph's wall time is ``run.json`` ``wall_time_s`` (input preparation,
 solver and all output maps); ANUGA's covers the mesh and quantity set-up and ``evolve``.
+``--floodsph-run DIR`` (one scenario only) takes floodsph's run from a completed run folder of
+that scenario instead of running it (no warm-up then: its wall time is what that run took).
 Without ANUGA (``pip install anuga``) the script prints that and exits with status 0.
 
 Usage: ``python workflows/versus_grid_code.py [SCENARIO ...] [--end-time S] [--threads N]
-[--out DIR]``
+[--floodsph-run DIR] [--out DIR]``
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import dataclasses
 import importlib.util
+import json
+import math
 import os
 import shutil
 import sys
@@ -139,6 +148,8 @@ class AnugaRun:
     triangles: int
     volume_initial_m3: float
     volume_final_m3: float
+    gauges: list = dataclasses.field(default_factory=list)
+    """Rows (time [s], id, depth [m], level [m], speed [m/s]); NaN level and speed when dry."""
 
 
 def walled_sides(walls, openings, width: float, height: float, tol: float) -> set[str]:
@@ -257,17 +268,52 @@ def run_anuga(scenario, inputs, walled: set[str], threads: int, work: Path) -> A
         anuga.Inlet_operator(domain, line, Q=lambda t, hg=hydrograph: float(hg.discharge(t)))
     maxima = Collect_max_quantities_operator(domain)
     volume0 = float(domain.get_water_volume())
+    points = inputs.gauges
+    yield_s = YIELD_S if points is None else scenario.gauges.interval_s
+    gauge_tri = [] if points is None else [
+        domain.get_triangle_containing_point([float(x), float(y)])
+        for x, y in zip(points.x, points.y, strict=True)]
     setup = time.perf_counter() - start
-    steps = 0
+    steps, rows = 0, []
     end = scenario.end_time_s
-    for _ in domain.evolve(yieldstep=min(YIELD_S, end), finaltime=end):
+    for t in domain.evolve(yieldstep=min(yield_s, end), finaltime=end):
         steps += domain.number_of_steps
+        if gauge_tri:
+            rows += gauge_rows(domain, float(t), points.ids, gauge_tri)
     wall = time.perf_counter() - start
     peak = np.maximum(maxima.max_depth, depth0)
     grid = centroids_to_grid(peak, cells, shape)
     grid[~(grid > 0.0)] = np.nan
     return AnugaRun(grid, wall, setup, steps, len(cells), volume0,
-                    float(domain.get_water_volume()))
+                    float(domain.get_water_volume()), rows)
+
+
+def gauge_rows(domain, t: float, ids, triangles, dry: float = 1e-3) -> list[tuple]:
+    """(t, id, depth, level, speed) of the centroids of ``triangles``; dry below ``dry`` m."""
+    q = domain.quantities
+    out = []
+    for gid, k in zip(ids, triangles, strict=True):
+        stage = float(q["stage"].centroid_values[k])
+        depth = max(stage - float(q["elevation"].centroid_values[k]), 0.0)
+        flux = math.hypot(q["xmomentum"].centroid_values[k], q["ymomentum"].centroid_values[k])
+        wet = depth > dry
+        out.append((t, gid, depth, stage if wet else math.nan, flux / depth if wet else math.nan))
+    return out
+
+
+def write_anuga_outputs(folder: Path, run: AnugaRun, threads: int) -> None:
+    """``anuga_gauges.csv`` (floodsph's ``gauges.csv`` columns) and ``anuga_run.json``."""
+    import anuga
+
+    if run.gauges:
+        with open(folder / "anuga_gauges.csv", "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(("time_s", "id", "depth_m", "level_m", "speed_ms"))
+            for t, gid, d, level, v in run.gauges:
+                w.writerow([f"{t:.3f}", gid, f"{d:.4f}", f"{level:.4f}", f"{v:.4f}"])
+    info = {k: v for k, v in dataclasses.asdict(run).items() if k not in ("max_depth", "gauges")}
+    info.update(version=anuga.__version__, threads=threads)
+    (folder / "anuga_run.json").write_text(json.dumps(info, indent=2) + "\n")
 
 
 def run_floodsph(scenario, out: Path, threads: int, progress: bool) -> dict:
@@ -345,9 +391,24 @@ def plot_side_by_side(path: Path, result, reference_on_model: np.ndarray) -> Pat
     return path
 
 
+def reused_floodsph_run(run_dir: Path, scenario) -> dict:
+    """The manifest of a completed floodsph run of ``scenario`` (same name and end time)."""
+    from floodsph.run.manifest import read_manifest
+
+    manifest = read_manifest(run_dir)
+    if manifest is None or manifest.get("status") != "completed":
+        raise SystemExit(f"{run_dir}: not a completed floodsph run folder")
+    ran = manifest["scenario"]["scenario"]
+    if ran["name"] != scenario.name or ran["end_time_s"] != scenario.end_time_s:
+        raise SystemExit(f"{run_dir}: a run of {ran['name']!r} to {ran['end_time_s']} s, not "
+                         f"of {scenario.name!r} to {scenario.end_time_s} s")
+    return manifest
+
+
 def compare_scenario(path: Path, out: Path, end_time: float | None, threads: int,
-                     progress: bool) -> dict:
-    """Both runs, the comparison outputs and the summary row of one scenario."""
+                     progress: bool, floodsph_run: Path | None = None) -> dict:
+    """Both runs (floodsph's taken from ``floodsph_run`` when given), the comparison outputs
+    and the summary row of one scenario."""
     from floodsph.inputs.prepare import prepare_inputs
     from floodsph.output.compare import align, compare, read_raster, write_outputs
     from floodsph.scenario.reader import load_scenario
@@ -363,12 +424,16 @@ def compare_scenario(path: Path, out: Path, end_time: float | None, threads: int
               "nearest valid elevation", file=sys.stderr)
     folder = out / scenario.name
     folder.mkdir(parents=True, exist_ok=True)
-    manifest = run_floodsph(scenario, folder / "floodsph", threads, progress)
+    if floodsph_run is None:
+        floodsph_run = folder / "floodsph"
+        manifest = run_floodsph(scenario, floodsph_run, threads, progress)
+    else:
+        manifest = reused_floodsph_run(floodsph_run, scenario)
     anuga = run_anuga(scenario, inputs, walled, threads, folder)
+    write_anuga_outputs(folder, anuga, threads)
     anuga_tif = write_grid_geotiff(folder / "anuga_max_depth.tif", anuga.max_depth,
                                    inputs.terrain, "ANUGA maximum depth")
-    result = compare(folder / "floodsph" / "max_depth.tif", anuga_tif,
-                     threshold=WET_THRESHOLD_M)
+    result = compare(floodsph_run / "max_depth.tif", anuga_tif, threshold=WET_THRESHOLD_M)
     write_outputs(result, folder / "comparison")
     on_model, _ = align(result.model, read_raster(anuga_tif))
     plot_side_by_side(folder / "max_depth_side_by_side.png", result, on_model)
@@ -385,8 +450,13 @@ def main(argv=None) -> int:
                         help="threads for both codes (default 1; 0 = all cores)")
     parser.add_argument("--out", type=Path, default=REPO / "workflows" / "results" /
                         "versus_grid_code", help="results folder")
+    parser.add_argument("--floodsph-run", type=Path, default=None,
+                        help="a completed floodsph run folder of the (single) scenario to "
+                             "use instead of running floodsph")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
+    if args.floodsph_run is not None and len(args.scenarios) != 1:
+        parser.error("--floodsph-run needs exactly one scenario")
     if not anuga_available():
         print("ANUGA is not installed (pip install anuga): the comparison is skipped.",
               file=sys.stderr)
@@ -397,7 +467,8 @@ def main(argv=None) -> int:
     rows = []
     for path in args.scenarios:
         rows.append(compare_scenario(path.resolve(), out, args.end_time, threads,
-                                     not args.quiet))
+                                     not args.quiet, args.floodsph_run and
+                                     args.floodsph_run.resolve()))
         r = rows[-1]
         print(f"{r['scenario']}: t = {r['sim_time_s']:g} s; floodsph {r['floodsph_wall_s']:.1f} s "
               f"wall ({r['floodsph_steps']} steps), ANUGA {r['anuga_wall_s']:.1f} s "
