@@ -232,64 +232,59 @@ def _subtract(acc, i, j, rho, t):
             acc[8] - w * ry * ry, acc[9] - fd, acc[10] - af * rx, acc[11] - af * ry)
 
 
-@njit(inline="always", cache=True)
+@njit(cache=True)
 def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, seg, s, s2, ds,
                      scheme):
     """Subtract from ``acc`` (:func:`_subtract`) the pair terms on particle i of the images of
     i and of its unblocked neighbours about segment s (s2 < 0) or about the corner of s and
-    s2.
+    s2 (:func:`_image_state`), i's own image first.
 
     ``ds`` is the distance [m] from i to segment s (0 for a corner): the image of j about s
     is at least ds - SIGHT_SLACK from i, so for ds >= 2 max(h_i, h_j) + SIGHT_SLACK its pair
-    term is zero and is skipped.
+    term is zero and is skipped; so is an image that does not apply (its terms are zero).
+    Compiled once and called, not inlined: the force kernel calls it for segments and for
+    corners, and with both inlined it took 108 s of a cold compile.
     """
     hi = h[i]
-    if ds < 2.0 * hi + SIGHT_SLACK:
-        if s2 < 0:
-            t = _image_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, scheme)
+    for q in range(nstart[i] - 1, nstart[i + 1]):
+        if q < nstart[i]:  # i's own image
+            j = i
+            if ds >= 2.0 * hi + SIGHT_SLACK:
+                continue
         else:
-            t = _corner_force(i, i, x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-        acc = _subtract(acc, i, i, rho, t)
-    for q in range(nstart[i], nstart[i + 1]):
-        if blocked[q] or ds >= 2.0 * max(hi, h[nbr[q]]) + SIGHT_SLACK:
-            continue
-        if s2 < 0:
-            t = _image_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, scheme)
-        else:
-            t = _corner_force(i, nbr[q], x, y, u, v, m, rho, h, coef, seg, s, s2, scheme)
-        acc = _subtract(acc, i, nbr[q], rho, t)
+            j = nbr[q]
+            if blocked[q] or ds >= 2.0 * max(hi, h[j]) + SIGHT_SLACK:
+                continue
+        ok, xm, ym, um, vm, kj = _image_state(i, j, x, y, u, v, coef, seg, s, s2)
+        if ok:
+            acc = _subtract(acc, i, j, rho, pair_force(x[i] - xm, y[i] - ym, u[i] - um,
+                                                       v[i] - vm, i, j, m, rho, h, coef, scheme,
+                                                       kj, image=j == i))
     return acc
 
 
 @njit(inline="always", cache=True)
-def _image_force(i, j, x, y, u, v, m, rho, h, coef, seg, s, scheme):
-    """:func:`pair_force` terms [m s-2] of i with j's mirror image across segment s: position
-    x_j' = 2 f_j - x_j, free-slip velocity v_j' = v_j - 2 (v_j . n) n, and j's renormalisation
-    tensor reflected, R K_j R with R = I - 2 n n^T; zeros when the wall does not hide the
-    image's point from i (MVBP mirror particles, method notes 3.1)."""
-    # wall_image's mirror and hides, with the mirror's normal kept for the velocity
-    xm, ym, _, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-    if not hides(x[i], y[i], xm, ym, seg, s):
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    vn = u[j] * nx + v[j] * ny
-    um = u[j] - 2.0 * vn * nx
-    vm = v[j] - 2.0 * vn * ny
-    kj = _reflect(coef[j, 4], coef[j, 5], coef[j, 6], nx, ny)
-    return pair_force(x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, i, j, m, rho, h, coef, scheme,
-                      kj, image=j == i)
+def _image_state(i, j, x, y, u, v, coef, seg, s, s2):
+    """(applies, x', y', u', v', K') of j's image as seen from i (MVBP mirror particles,
+    method notes 3.1).
 
-
-@njit(inline="always", cache=True)
-def _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s1, s2, scheme):
-    """:func:`pair_force` terms [m s-2] of i with j's point reflection through the right-angled
-    corner of segments s1 and s2: the velocity and K_j reflected about both walls' normals in
-    turn (v' = R2 R1 v_j, K' = R2 R1 K_j R1 R2); zeros when that image does not apply
-    (method notes 3.1)."""
-    xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
-    if not ok:
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    # two reflections of the velocity: about s1's normal, then s2's
-    _, _, _, n1x, n1y = mirror(x[j], y[j], seg[s1, 0], seg[s1, 1], seg[s1, 2], seg[s1, 3])
+    About segment s (s2 < 0): position x_j' = 2 f_j - x_j (f_j the foot of j on the wall),
+    free-slip velocity v_j' = v_j - 2 (v_j . n) n and renormalisation tensor R K_j R,
+    R = I - 2 n n^T; it applies where the wall hides the image's point from i. Through the
+    right-angled corner of s and s2: the point reflection, the velocity and K_j reflected
+    about both walls' normals in turn (v' = R2 R1 v_j, K' = R2 R1 K_j R1 R2), where
+    ``floodsph.walls.images.corner_image`` says it applies.
+    """
+    if s2 < 0:
+        xm, ym, _, nx, ny = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+        ok = hides(x[i], y[i], xm, ym, seg, s)
+        vn = u[j] * nx + v[j] * ny
+        um = u[j] - 2.0 * vn * nx
+        vm = v[j] - 2.0 * vn * ny
+        kj = _reflect(coef[j, 4], coef[j, 5], coef[j, 6], nx, ny)
+        return ok, xm, ym, um, vm, kj
+    xm, ym, ok = corner_image(x[j], y[j], seg, s, s2)
+    _, _, _, n1x, n1y = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
     _, _, _, n2x, n2y = mirror(x[j], y[j], seg[s2, 0], seg[s2, 1], seg[s2, 2], seg[s2, 3])
     vn = u[j] * n1x + v[j] * n1y
     um = u[j] - 2.0 * vn * n1x
@@ -299,8 +294,7 @@ def _corner_force(i, j, x, y, u, v, m, rho, h, coef, seg, s1, s2, scheme):
     vm -= 2.0 * vn * n2y
     kxx, kxy, kyy = _reflect(coef[j, 4], coef[j, 5], coef[j, 6], n1x, n1y)
     kj = _reflect(kxx, kxy, kyy, n2x, n2y)
-    return pair_force(x[i] - xc, y[i] - yc, u[i] - um, v[i] - vm, i, j, m, rho, h, coef, scheme,
-                      kj, image=j == i)
+    return ok, xm, ym, um, vm, kj
 
 
 @njit(inline="always", cache=True)
