@@ -77,14 +77,11 @@ def _corner(i, j, x, y, m, hi, seg, s1, s2):
     return _pair(x[i] - xc, y[i] - yc, m[j], hi)
 
 
-@njit(cache=True)
+@njit(inline="always", cache=True)
 def _image_sums(rsum, alpha, i, hi, x, y, m, nstart, nbr, blocked, walls):
     """Add the mirror images' terms of particle i to its summation ``rsum`` and ``alpha``
     (:func:`summation`), segment by segment, each followed by the corners it opens.
 
-    Compiled once and called, not inlined, so that the density solve that calls
-    :func:`summation` twice compiles the image loops once (a cold compile of the solver took
-    80 s with them inlined in both places).
     """
     seg, wdist, wstart, wseg, cstart, cpair = walls
     reach = 2.0 * hi + SIGHT_SLACK
@@ -199,21 +196,25 @@ def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, walls, t
     for k in prange(rows.shape[0]):
         i = rows[k]
         it = 0
-        done = False
         h_low = h_shrink * h[i]
         h_rho = _h_of_rho(h0[i], rho0[i], rho[i], h_ratio)
         capped = h_rho > h_cap[i]
         held = h_rho < h_low
         h[i] = min(max(h_rho, h_low), h_cap[i])
-        while it < max_iter and not capped and not held:
+        while True:  # one summation call site: the solver compiles its loops once
+            last = it >= max_iter or capped or held
             s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, walls)
             if integral:
                 s, a = wall_corrected(i, h[i], s, a, x, y, walls.wstart, walls.wseg, walls.seg)
             alpha[i] = a
+            if last:  # the plain summation at the h reached
+                rho[i] = s
+                iters[i] = 0 if capped else (max_iter + 1 if held else -it)
+                break
             it += 1
             res = rho[i] - s
             if abs(res) < tol * rho[i]:
-                done = True
+                iters[i] = it
                 break
             new = rho[i] * (1.0 - 2.0 * res / (2.0 * res + alpha[i]))
             if not (new > 0.0) or not math.isfinite(new) or alpha[i] <= 0.0:
@@ -223,15 +224,6 @@ def solve(rows, x, y, m, rho, h, h0, rho0, alpha, nstart, nbr, blocked, walls, t
             held = h_new < h_low
             rho[i] = new
             h[i] = min(max(h_new, h_low), h_cap[i])
-        if done:
-            iters[i] = it
-        else:
-            s, a = summation(i, h[i], x, y, m, nstart, nbr, blocked, walls)
-            if integral:
-                s, a = wall_corrected(i, h[i], s, a, x, y, walls.wstart, walls.wseg, walls.seg)
-            rho[i] = s
-            alpha[i] = a
-            iters[i] = 0 if capped else (max_iter + 1 if held else -it)
 
 
 @njit(parallel=True, cache=True)

@@ -193,16 +193,29 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nst
             acc = _subtract(acc, i, j, rho, pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m,
                                                        rho, h, coef, scheme,
                                                        (coef[j, 4], coef[j, 5], coef[j, 6])))
+        # each near segment's single images, then the corners it opens, in list order; one
+        # call site, so that the image terms are compiled once into this kernel
+        w = wstart[i]
         c = cstart[i]
-        for w in range(wstart[i], wstart[i + 1]):
+        single = True  # segment w's single images still to take
+        while w < wstart[i + 1]:
             s = wseg[w]
-            if wdist[w] < 2.0 * h_reach + SIGHT_SLACK:
-                acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
-                                       seg, s, -1, wdist[w], scheme)
-            while c < cstart[i + 1] and cpair[c, 0] == s:
-                acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
-                                       seg, s, cpair[c, 1], 0.0, scheme)
+            s2 = -1
+            ds = wdist[w]
+            if single:
+                single = False
+                if ds >= 2.0 * h_reach + SIGHT_SLACK:
+                    continue
+            elif c < cstart[i + 1] and cpair[c, 0] == s:
+                s2 = cpair[c, 1]
+                ds = 0.0
                 c += 1
+            else:
+                w += 1
+                single = True
+                continue
+            acc = _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef,
+                                   seg, s, s2, ds, scheme)
         ax[i] = acc[0]
         ay[i] = acc[1]
         for c in range(7):  # D, E and g M
@@ -232,7 +245,7 @@ def _subtract(acc, i, j, rho, t):
             acc[8] - w * ry * ry, acc[9] - fd, acc[10] - af * rx, acc[11] - af * ry)
 
 
-@njit(cache=True)
+@njit(inline="always", cache=True)
 def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, seg, s, s2, ds,
                      scheme):
     """Subtract from ``acc`` (:func:`_subtract`) the pair terms on particle i of the images of
@@ -242,8 +255,9 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
     ``ds`` is the distance [m] from i to segment s (0 for a corner): the image of j about s
     is at least ds - SIGHT_SLACK from i, so for ds >= 2 max(h_i, h_j) + SIGHT_SLACK its pair
     term is zero and is skipped; so is an image that does not apply (its terms are zero).
-    Compiled once and called, not inlined: the force kernel calls it for segments and for
-    corners, and with both inlined it took 108 s of a cold compile.
+    The pair term appears once here for every kind of image, and the force kernel calls this
+    from one place: with a copy of the pair term for each image kind and each call, the
+    kernel's cold compile took 66 s on two cores (``workflows/compile_time.py``).
     """
     hi = h[i]
     for q in range(nstart[i] - 1, nstart[i + 1]):
