@@ -80,9 +80,7 @@ def _corner(i, j, x, y, m, hi, seg, s1, s2):
 @njit(inline="always", cache=True)
 def _image_sums(rsum, alpha, i, hi, x, y, m, nstart, nbr, blocked, walls):
     """Add the mirror images' terms of particle i to its summation ``rsum`` and ``alpha``
-    (:func:`summation`), segment by segment, each followed by the corners it opens.
-
-    """
+    (:func:`summation`), segment by segment, each followed by the corners it opens."""
     seg, wdist, wstart, wseg, cstart, cpair = walls
     reach = 2.0 * hi + SIGHT_SLACK
     c = cstart[i]
