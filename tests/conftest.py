@@ -75,6 +75,7 @@ polygon = [[{X0}, {Y0}], [{X0 + NX * CELL}, {Y0}], [{X0 + NX * CELL}, {Y0 + NY *
 particle_spacing_m = 10.0
 cfl = 0.3
 refinement = "none"
+time_stepping = "global"
 
 [output]
 resolution_m = 10.0

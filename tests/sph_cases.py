@@ -8,7 +8,7 @@ from floodsph.inputs.initial_water import particles_at
 from floodsph.model.builder import set_up_model
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
-from floodsph.scenario.numerics import Numerics
+from floodsph.scenario.numerics import Numerics, TimeStepping
 
 
 def lattice(x0, x1, y0, y1, dx):
@@ -25,7 +25,11 @@ def particles_with_depth(x, y, d, dx, kappa, u=0.0, v=0.0) -> ParticleSet:
 
 def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, manning=0.0,
              walls=(), closed=True, **numerics):
-    """A FloodModel with water given as a level (float) or a depth function d(x, y)."""
+    """A FloodModel with water given as a level (float) or a depth function d(x, y).
+
+    ``numerics``: fields of its ``Numerics``; ``time_stepping`` defaults to the global step,
+    whose facts (exact momentum, one step per call) these cases assert; a test of local
+    steps asks for them."""
     terrain = Terrain.from_function(bed, xlim, ylim, cell, manning=manning)
     x, y = lattice(0.0, terrain.width, 0.0, terrain.height, dx)
     xw, yw = x + terrain.x0, y + terrain.y0
@@ -34,7 +38,8 @@ def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, ma
     else:
         d = np.maximum(level_or_depth - bed(xw, yw), 0.0)
     p = particles_with_depth(x, y, np.asarray(d, dtype=float), dx, kappa)
-    num = Numerics(particle_spacing_m=dx, kappa=kappa, **numerics)
+    num = Numerics(particle_spacing_m=dx, kappa=kappa,
+                   **{"time_stepping": TimeStepping.GLOBAL, **numerics})
     return set_up_model(terrain, p, num, walls=walls, closed_edges=closed)
 
 

@@ -2,9 +2,10 @@
 
 Each page (``<out>/<case>.md``, default ``docs/validation``) gives the case's set-up, the L1
 relative depth error, front error, mass error and solver wall time at three particle spacings
-with the default numerics (``floodsph.scenario.numerics.Numerics()``: ``split+coalesce`` refinement,
-one global time step) and with refinement ``none``, and a figure beside it (``<case>.png``):
-the depth profile of each default run at the end time against the exact solution. The runs are
+with the default refinement (``floodsph.scenario.numerics.Numerics()``: ``split+coalesce``) and
+with refinement ``none``, both with one global time step (``floodsph.verification.cases``),
+and a figure beside it (``<case>.png``): the depth profile of each default run at the end
+time against the exact solution. The runs are
 those of ``floodsph.verification.cases`` (the real solver path on an analytic bed) and the exact
 solutions those of ``floodsph.verification.exact``.
 
@@ -167,9 +168,11 @@ def page(case: str, rows, machine: Machine, picture: Path | None, command: str) 
              f"{machine.note()}", "",
              "## Set-up", "", *setup_text(case), "",
              "## Error against the exact solution", "",
-             f"Default numerics (refinement `{DEFAULT.value}`, global time step) beside "
-             "uniform resolution (refinement `none`). Solver wall time is the stepping loop "
-             "only (the kernels compiled before).", "",
+             f"Default refinement (`{DEFAULT.value}`) beside uniform resolution (refinement "
+             "`none`), both with one global time step (scenarios default to local steps; "
+             "[local time steps](../local_steps/speed_vs_error.md) has these cases with "
+             "them). Solver wall time is the stepping loop only (the kernels compiled "
+             "before).", "",
              table(rows), ""]
     order = order_text(rows)
     lines += [order, ""] if order else []

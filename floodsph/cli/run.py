@@ -29,7 +29,8 @@ EXIT_STATUS = {"completed": 0, "stopped": 0, "interrupted": 130}
     "--max-steps",
     type=click.IntRange(min=1),
     default=None,
-    help="Stop after this many time steps (a trial run; status \"stopped\").",
+    help="Stop after this many time steps (a trial run; status \"stopped\"); with local "
+         "time steps, at the end of the big step that holds the last.",
 )
 @click.pass_context
 def command(ctx: click.Context, scenario: Path, output, overwrite: bool, resume: bool,

@@ -61,8 +61,8 @@ def run_scenario(
     out_dir : path, optional
         The run folder; default ``scenario.output_directory`` (``out/<name>``).
     max_steps : int, optional
-        Stop after this many steps (a trial run: status ``"stopped"`` unless the end time
-        came first).
+        Stop after this many time steps (a trial run: status ``"stopped"`` unless the end time
+        came first); with local time steps, at the end of the big step that holds the last.
     progress : bool
         Show the progress bar (it is off anyway when stderr is not a terminal).
     overwrite : bool

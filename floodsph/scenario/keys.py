@@ -281,8 +281,9 @@ NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are 
            "may coalesce; must be below refine_area_max / 2."),
     KeyDoc("refine_d_min_m", "number", "Particles shallower than this are not split.", "m"),
     KeyDoc("refine_max_level", "integer", "At most this many generations of splitting."),
-    KeyDoc("time_stepping", "string", "`global`: one time step for every particle; `local`: "
-           "each particle at its own power-of-two multiple of the finest step (opt-in).",
+    KeyDoc("time_stepping", "string", "`local` (default): each particle at its own "
+           "power-of-two multiple of the finest step; `global`: one time step for every "
+           "particle.",
            choices=TimeStepping),
     KeyDoc("step_levels", "integer", "With local time stepping, a big step holds at most "
            "2^step_levels finest steps (0 to 6)."),

@@ -48,7 +48,9 @@ class Simulation:
     callbacks : sequence of (callable, schedule)
         ``callable(sim)`` runs when ``schedule.due(sim)``; see the module docstring.
     max_steps : int, optional
-        Stop after this many steps even before ``end_time`` (for trial runs).
+        Stop once this many time steps are taken, even before ``end_time`` (for trial runs).
+        With local time stepping these are finest steps, and the loop stops at the end of
+        the big step that holds the last of them (at most 2^step_levels - 1 more).
     should_stop : callable, optional
         ``should_stop() -> bool``, asked after every step; True ends the loop
         (:attr:`interrupted`).
@@ -128,8 +130,9 @@ class Simulation:
                     schedule.next_time = next_time
         log.info("simulation started: end time %g s, %d particles", self.end_time, self.n)
         while not self.finished:
+            before = self.model.steps
             self.last_dt = self.model.step(dt_max=self.dt_max())
-            self.steps_taken += 1
+            self.steps_taken += self.model.steps - before
             self.check_state()
             for k, (func, schedule) in enumerate(self.callbacks):
                 if schedule.due(self):

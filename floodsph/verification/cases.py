@@ -27,7 +27,7 @@ from floodsph.inputs.initial_water import particles_at
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
-from floodsph.scenario.numerics import Numerics, Refinement
+from floodsph.scenario.numerics import Numerics, Refinement, TimeStepping
 from floodsph.verification import exact, metrics
 
 
@@ -105,7 +105,9 @@ class CaseResult:
 def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **numerics):
     """A FloodModel on an analytic bed with particles on a lattice of spacing dx where the
     depth exceeds 1 mm; ``numerics``: fields of its ``Numerics`` (``refinement`` default
-    ``Refinement.NONE``: uniform resolution; another mode adds a refiner)."""
+    ``Refinement.NONE``: uniform resolution, another mode adds a refiner; ``time_stepping``
+    default ``TimeStepping.GLOBAL``, the step the validation pages' figures were measured
+    with)."""
     from floodsph.model.refinement import Refiner
 
     terrain = Terrain.from_function(bed, xlim, ylim, cell)
@@ -115,7 +117,8 @@ def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **nume
     p = particles_at(x, y, depth(xw, yw), dx, kappa, u=u(xw, yw) if callable(u) else u,
                      v=v(xw, yw) if callable(v) else v, d_min=1e-3)
     num = Numerics(particle_spacing_m=dx, kappa=kappa,
-                   **{"refinement": Refinement.NONE, **numerics})
+                   **{"refinement": Refinement.NONE, "time_stepping": TimeStepping.GLOBAL,
+                      **numerics})
     return set_up_model(terrain, p, num, refiner=Refiner.of(num))
 
 

@@ -175,7 +175,8 @@ def page(command, machine, records, row, fs_rows, an_rows, balance, anuga, expec
         f"* Both codes on the 10 m DEM (the report recommends 5 m), t = 0 to {end:g} s "
         f"{'(the full test)' if end >= ea4.END_TIME_S else '(shorter than the 18 000 s test)'}.",
         "* floodsph: `workflows/ea_test4/run_ea_test4.py --dem-cell 10`, particles at 10 m, "
-        "default numerics (split+coalesce refinement, one global time step).",
+        "split+coalesce refinement (the default) and one global time step (the workflow's "
+        "default).",
         "* ANUGA: `workflows/versus_grid_code.py` on the scenario that script writes: four "
         "triangles per DEM cell, the inflow an `Inlet_operator` on the opening, "
         "`Reflective_boundary` on the west edge, `Transmissive_boundary` on the others; a "

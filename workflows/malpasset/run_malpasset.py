@@ -146,7 +146,7 @@ def main(argv=None) -> int:
     parser.add_argument("--refinement", choices=("split+coalesce", "split", "none"),
                         default=None, help="numerics.refinement (default: floodsph's)")
     parser.add_argument("--time-stepping", choices=("global", "local"), default=None,
-                        help="numerics.time_stepping (default: floodsph's, global)")
+                        help="numerics.time_stepping (default: floodsph's, local)")
     parser.add_argument("--no-summary", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--write-static", action="store_true",
                         help="(re)write workflows/malpasset/scenario.toml and exit")
