@@ -96,7 +96,7 @@ POLY = "[[0, 0], [10, 0], [10, 10]]"
          "pair is not split again at once; got 1.5"),
         (('refinement = "none"', "refine_max_level = -1"),
          "numerics.refine_max_level: must be >= 0, got -1"),
-        (('refinement = "none"', 'time_stepping = "sideways"'),
+        (('time_stepping = "global"', 'time_stepping = "sideways"'),
          "numerics.time_stepping: expected one of 'global', 'local', got string 'sideways'"),
         (('refinement = "none"', "step_levels = 9"),
          "numerics.step_levels: must be <= 6, got 9"),
