@@ -19,6 +19,10 @@ from scipy import ndimage
 
 from floodsph.walls.geometry import segment_distance
 
+NEAR_BUCKETS = 2.0
+"""Radius, in level-0 buckets, up to which a particle's near segments are found among its own
+bucket's precomputed candidates (:func:`_near_scan`); larger radii walk the bucket pyramid."""
+
 
 class NearWalls(NamedTuple):
     """CSR lists of each particle's near wall segments and of its wall corners.
@@ -96,6 +100,14 @@ class WallIndex:
         self.items = np.concatenate(items)
         nbx, nby = shapes[0]
         self.clear = _clearance(counts[0].reshape(nby, nbx) > 0, sizes[0])
+        # per level-0 bucket, the segments whose box widened by near_radius overlaps it
+        self.near_radius = NEAR_BUCKETS * sizes[0]
+        lo = np.minimum(self.seg[:, :2], self.seg[:, 2:]) - self.near_radius
+        hi = np.maximum(self.seg[:, :2], self.seg[:, 2:]) + self.near_radius
+        near_counts, self.near_items = _bucket_lists(np.hstack([lo, hi]), self.xmin, self.ymin,
+                                                     sizes[0], nbx, nby)
+        self.near_start = np.zeros(nbx * nby + 1, dtype=np.int64)
+        np.cumsum(near_counts, out=self.near_start[1:])
         self.pstart, self.partner = _corner_partners(self.seg)
         self.width = 16  # row width of the near-segment scan, widened when a row overflows
 
@@ -112,8 +124,8 @@ class WallIndex:
             return NearWalls(wstart, np.zeros(0, dtype=np.int64), cstart,
                              np.zeros((0, 2), dtype=np.int64))
         args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items, self.clear,
-                self.xmin, self.ymin, self.lv_bucket, self.lv_nbx, self.lv_nby, self.lv_off,
-                float(h.max()))
+                self.near_radius, self.near_start, self.near_items, self.xmin, self.ymin,
+                self.lv_bucket, self.lv_nbx, self.lv_nby, self.lv_off, float(h.max()))
         count = np.empty(n, dtype=np.int64)
         while True:  # one scan into rows of ``width``; again, wider, if a row overflowed
             rows = np.empty((n, self.width), dtype=np.int64)
@@ -185,13 +197,16 @@ def first_visit(seg, s, bx, by, qbx0, qby0, xmin, ymin, bucket, nbx, nby):
 
 
 @njit(parallel=True, cache=True)
-def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, xmin, ymin, lv_bucket,
-               lv_nbx, lv_nby, lv_off, h_top, rows, count):
+def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, near_radius, near_start,
+               near_items, xmin, ymin, lv_bucket, lv_nbx, lv_nby, lv_off, h_top, rows, count):
     """Count (into ``count[i]``) and list (into ``rows[i]``, in index order, as far as the row
     is wide) each particle's segments within reach * max(h_i, max_j h_j); a particle inside
     the level-0 grid whose radius is below its bucket's ``clear`` distance has none (tested
-    first with the largest h of all, ``h_top``, before its neighbours are walked). The
-    buckets walked are those of the finest level at least half as wide as the radius."""
+    first with the largest h of all, ``h_top``, before its neighbours are walked). One whose
+    radius is at most ``near_radius`` tests its level-0 bucket's candidates
+    (``near_items[near_start[b]:near_start[b + 1]]``, every segment within ``near_radius`` of
+    the bucket, in index order); the others walk the buckets of the finest level at least
+    half as wide as the radius."""
     width = rows.shape[1]
     top = lv_bucket.shape[0] - 1
     for i in prange(x.shape[0]):
@@ -206,6 +221,18 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, xmin, ymi
             hr = max(hr, h[nbr[k]])
         radius = reach * hr
         if inside and radius < clear[int(cy) * lv_nbx[0] + int(cx)]:
+            continue
+        if inside and radius <= near_radius:
+            b = int(cy) * lv_nbx[0] + int(cx)
+            k = 0
+            for q in range(near_start[b], near_start[b + 1]):
+                s = near_items[q]
+                if segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2],
+                                    seg[s, 3]) < radius:
+                    if k < width:
+                        rows[i, k] = s
+                    k += 1
+            count[i] = k
             continue
         lv = 0
         while lv < top and lv_bucket[lv] < 0.5 * radius:
