@@ -226,12 +226,7 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, near_radi
             b = int(cy) * lv_nbx[0] + int(cx)
             k = 0
             for q in range(near_start[b], near_start[b + 1]):
-                s = near_items[q]
-                if segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2],
-                                    seg[s, 3]) < radius:
-                    if k < width:
-                        rows[i, k] = s
-                    k += 1
+                k = _take_if_near(x[i], y[i], seg, near_items[q], radius, rows[i], k)
             count[i] = k
             continue
         lv = 0
@@ -248,16 +243,22 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, near_radi
                 b = lv_off[lv] + by * nbx + bx
                 for q in range(bstart[b], bstart[b + 1]):
                     s = items[q]
-                    if not first_visit(seg, s, bx, by, bx0, by0, xmin, ymin, bucket, nbx, nby):
-                        continue
-                    if segment_distance(x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2],
-                                        seg[s, 3]) < radius:
-                        if k < width:
-                            rows[i, k] = s
-                        k += 1
+                    if first_visit(seg, s, bx, by, bx0, by0, xmin, ymin, bucket, nbx, nby):
+                        k = _take_if_near(x[i], y[i], seg, s, radius, rows[i], k)
         count[i] = k
         if k <= width:
             _sort_run(rows[i], 0, k)
+
+
+@njit(inline="always", cache=True)
+def _take_if_near(px, py, seg, s, radius, row, k):
+    """Append segment s to ``row`` at position k (as far as the row is wide) if it lies within
+    ``radius`` [m] of the point (px, py); return the new count."""
+    if segment_distance(px, py, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]) < radius:
+        if k < row.shape[0]:
+            row[k] = s
+        k += 1
+    return k
 
 
 @njit(parallel=True, cache=True)
