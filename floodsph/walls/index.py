@@ -69,7 +69,11 @@ class WallIndex:
     any segment: with e_b the Euclidean distance, in buckets, from b's centre to the centre of
     the nearest bucket that lists a segment (a distance transform of the bucket grid), two
     points in the two buckets are at least (e_b - sqrt 2) bucket apart. A particle whose
-    radius is below it has no near segment and skips the bucket walk.
+    radius is below it has no near segment and skips the bucket walk. Each bucket of level 0
+    also lists its candidates, every segment whose box widened by ``near_radius``
+    (``NEAR_BUCKETS`` buckets) overlaps it: a particle of that reach or less tests them alone,
+    without the walk (on the dam break of ``workflows/step_cost.py`` at 4,000 particles, the
+    lists took 0.24 ms a step instead of 0.79).
     """
 
     def __init__(self, seg: np.ndarray, bounds, bucket: float):
@@ -214,18 +218,18 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, near_radi
         cx = (x[i] - xmin) / lv_bucket[0]
         cy = (y[i] - ymin) / lv_bucket[0]
         inside = 0.0 <= cx < lv_nbx[0] and 0.0 <= cy < lv_nby[0]
-        if inside and reach * h_top < clear[int(cy) * lv_nbx[0] + int(cx)]:
+        b0 = int(cy) * lv_nbx[0] + int(cx)  # i's level-0 bucket, when inside
+        if inside and reach * h_top < clear[b0]:
             continue
         hr = h[i]
         for k in range(nstart[i], nstart[i + 1]):
             hr = max(hr, h[nbr[k]])
         radius = reach * hr
-        if inside and radius < clear[int(cy) * lv_nbx[0] + int(cx)]:
+        if inside and radius < clear[b0]:
             continue
         if inside and radius <= near_radius:
-            b = int(cy) * lv_nbx[0] + int(cx)
             k = 0
-            for q in range(near_start[b], near_start[b + 1]):
+            for q in range(near_start[b0], near_start[b0 + 1]):
                 k = _take_if_near(x[i], y[i], seg, near_items[q], radius, rows[i], k)
             count[i] = k
             continue
