@@ -26,9 +26,11 @@ triangle (ANUGA) holding the point.
 Codes and resolutions (spacing of the particles, side of the square cells; ANUGA cuts each
 square into four triangles):
 
-* floodsph in three modes: no refinement with one global step; split+coalesce with the global
+* floodsph in five modes: no refinement with one global step; split+coalesce with the global
   step; split+coalesce with local steps (``Numerics.refinement``, ``Numerics.time_stepping``);
-  dam breaks at 10, 5, 2.5 m, Thacker at 200, 100, 50 m.
+  and the first and the last again with the reconstructed dissipation
+  (``Numerics.stabilisation = "muscl"``); dam breaks at 10, 5, 2.5 m, Thacker at 200, 100,
+  50 m.
 * GeoClaw 5.x and ANUGA 4.x (set-ups: ``workflows/pareto_peers.py``) at those resolutions and
   coarser and finer ones, so that their curves bracket floodsph's errors: dam breaks at 50,
   25, 10, 5 and 2.5 m (GeoClaw needs 4 cells across the channel: not at 50 m), Thacker at 400
@@ -98,7 +100,7 @@ from floodsph import __version__ as FLOODSPH_VERSION  # noqa: E402
 from floodsph.constants import GRAVITY  # noqa: E402
 from floodsph.output.tables import markdown, write_csv  # noqa: E402
 from floodsph.run.pipeline import set_threads  # noqa: E402
-from floodsph.scenario.numerics import Refinement, TimeStepping  # noqa: E402
+from floodsph.scenario.numerics import Refinement, Stabilisation, TimeStepping  # noqa: E402
 from floodsph.verification import cases, exact, metrics  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
@@ -114,16 +116,26 @@ CHANNEL_LINES_Y = (12.5, 37.5, 62.5, 87.5)
 # -- cases, modes, sample points -------------------------------------------------------------
 @dataclass(frozen=True)
 class Mode:
-    """A floodsph mode: its refinement and time stepping."""
+    """A floodsph mode: its refinement, time stepping and stabilisation."""
 
     label: str
     refinement: Refinement
     time_stepping: TimeStepping
+    stabilisation: Stabilisation = Stabilisation.LAX_FRIEDRICHS
+
+    @property
+    def numerics(self) -> dict:
+        """The mode as fields of ``Numerics``."""
+        return {"refinement": self.refinement, "time_stepping": self.time_stepping,
+                "stabilisation": self.stabilisation}
 
 
 MODES = (Mode("none, global", Refinement.NONE, TimeStepping.GLOBAL),
          Mode("split+coalesce, global", Refinement.SPLIT_COALESCE, TimeStepping.GLOBAL),
-         Mode("split+coalesce, local", Refinement.SPLIT_COALESCE, TimeStepping.LOCAL))
+         Mode("split+coalesce, local", Refinement.SPLIT_COALESCE, TimeStepping.LOCAL),
+         Mode("none, global, muscl", Refinement.NONE, TimeStepping.GLOBAL, Stabilisation.MUSCL),
+         Mode("split+coalesce, local, muscl", Refinement.SPLIT_COALESCE, TimeStepping.LOCAL,
+              Stabilisation.MUSCL))
 
 
 @dataclass(frozen=True)
@@ -249,7 +261,7 @@ class Peer:
 
 
 def floodsph_run(case: Case, mode: Mode, dx: float, samples: Samples, threads: int) -> Run:
-    r = case.run(dx, refinement=mode.refinement, time_stepping=mode.time_stepping)
+    r = case.run(dx, **mode.numerics)
     return Run(case.name, "floodsph", FLOODSPH_VERSION, mode.label, dx, r.particles_max,
                "particles (peak)", r.steps, r.wall_s, case.floodsph_l1(r, samples), threads)
 
@@ -258,8 +270,7 @@ def warm_up(names, modes) -> None:
     """Compile (or load) floodsph's kernels: each case and mode once at a coarse spacing."""
     for name in names:
         for mode in modes:
-            CASES[name].run(CASES[name].warm_up_res, refinement=mode.refinement,
-                            time_stepping=mode.time_stepping)
+            CASES[name].run(CASES[name].warm_up_res, **mode.numerics)
 
 
 def peer_env(threads: int) -> dict:

@@ -406,14 +406,14 @@ def build_cases(kinds, folder: Path, quick: bool, end_times: dict) -> list[cases
     return out
 
 
-def set_wall_model(case: cases.Case, wall_model: str) -> None:
-    """Write ``[numerics] wall_model`` into the case's scenario file."""
+def set_numerics(case: cases.Case, keys: dict) -> None:
+    """Write ``keys`` into the ``[numerics]`` table of the case's scenario file."""
     import tomllib
 
     import tomli_w
 
     data = tomllib.loads(case.scenario.read_text(encoding="utf-8"))
-    data.setdefault("numerics", {})["wall_model"] = wall_model
+    data.setdefault("numerics", {}).update(keys)
     case.scenario.write_text(tomli_w.dumps(data), encoding="utf-8")
 
 
@@ -452,9 +452,11 @@ def run_benchmark(args) -> Benchmark:
     load0 = os.getloadavg()[0]
     kinds = args.cases or [k for k in KINDS if not (args.quick and k == "malpasset")]
     runs = []
+    numerics = {k: getattr(args, k) for k in ("wall_model", "stabilisation")
+                if getattr(args, k)}
     for case in build_cases(kinds, args.out / "scenarios", args.quick, end_times(args)):
-        if args.wall_model:
-            set_wall_model(case, args.wall_model)
+        if numerics:
+            set_numerics(case, numerics)
         runs.append(run_case(case, args.out / "runs" / case.scenario.parent.name))
         print(f"{case.label}: done, {runs[-1].manifest['wall_time_s']:.1f} s", flush=True)
     command = " ".join(["NUMBA_NUM_THREADS=" + os.environ.get("NUMBA_NUM_THREADS", "(all)"),
@@ -601,6 +603,9 @@ def parse_args(argv=None):
     ap.add_argument("--quick", action="store_true", help="tiny, short synthetic cases")
     ap.add_argument("--wall-model", choices=("mirror", "integral"),
                     help="[numerics] wall_model of every case (default: the scenario default)")
+    ap.add_argument("--stabilisation", choices=("lax-friedrichs", "riemann", "muscl"),
+                    help="[numerics] stabilisation of every case (default: the scenario "
+                    "default)")
     ap.add_argument("--out", type=Path, default=Path("results/still_water"))
     ap.add_argument("--doc", type=Path, help="the report (default docs/still-water.md; with "
                     "--quick <out>/still-water.md)")

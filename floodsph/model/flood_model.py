@@ -33,6 +33,7 @@ from floodsph.sph import consistency, density, forces, shore, time_step
 from floodsph.sph.cells import CellGrid
 from floodsph.sph.neighbours import NeighbourList
 from floodsph.sph.sums import SUMS
+from floodsph.sph.velocity_gradient import velocity_gradient
 from floodsph.walls import shadow, sight
 from floodsph.walls.index import WallIndex, WallLists
 
@@ -89,7 +90,8 @@ class FloodModel:
         self.particles = particles
         self.numerics = numerics
         self.scheme = {Stabilisation.LAX_FRIEDRICHS: forces.LAX_FRIEDRICHS,
-                       Stabilisation.RIEMANN: forces.RIEMANN}[numerics.stabilisation]
+                       Stabilisation.RIEMANN: forces.RIEMANN,
+                       Stabilisation.MUSCL: forces.MUSCL}[numerics.stabilisation]
         self.closed_edges = closed_edges
         self.seg = seg
         h0 = numerics.kappa * numerics.particle_spacing_m
@@ -379,10 +381,13 @@ class FloodModel:
         bedmod.sample_bed(rows, p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
             self.block_pairs()
+        if self.scheme == forces.MUSCL:
+            velocity_gradient(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, self.nl.start,
+                              self.nl.nbr, self.blocked, p.dudx, p.dudy, p.dvdx, p.dvdy)
         forces.internal_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h, p.kxx,
-                                     p.kxy, p.kyy, self.nl.start, self.nl.nbr, self.blocked,
-                                     self.wall_lists(), self.scheme, self.pair_sums, p.ax,
-                                     p.ay, p.divv)
+                                     p.kxy, p.kyy, p.dudx, p.dudy, p.dvdx, p.dvdy, self.nl.start,
+                                     self.nl.nbr, self.blocked, self.wall_lists(), self.scheme,
+                                     self.pair_sums, p.ax, p.ay, p.divv)
         consistency.update_renormalisation(rows, p.h, self.pair_sums, self.shores, p.kxx, p.kxy,
                                            p.kyy)
         if self.walled.shape[0] != p.n:

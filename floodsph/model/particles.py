@@ -31,11 +31,19 @@ FIELDS: dict[str, tuple[type, str]] = {
     "kxx": (np.float64, "-, pressure renormalisation K, xx (floodsph.sph.consistency)"),
     "kxy": (np.float64, "-, the same, xy"),
     "kyy": (np.float64, "-, the same, yy"),
+    "dudx": (np.float64, "s-1, velocity gradient du/dx at the last force evaluation"),
+    "dudy": (np.float64, "s-1, the same, du/dy"),
+    "dvdx": (np.float64, "s-1, the same, dv/dx"),
+    "dvdy": (np.float64, "s-1, the same, dv/dy"),
     "level": (np.int64, "refinement level: number of splits in the particle's ancestry"),
     "born": (np.int64, "step at which the particle was created (split, merge or inflow)"),
     "stride": (np.int64, "local time stepping: own step in finest steps (0: not yet set)"),
     "pid": (np.int64, "unique particle id, never reused"),
 }
+
+VELOCITY_GRADIENT = ("dudx", "dudy", "dvdx", "dvdy")
+"""The fields of the velocity gradient (``floodsph.sph.forces.reconstructed_jump``): daughters
+inherit their parent's, a merged particle takes its pair's mass-weighted mean."""
 
 
 class ParticleSet:
@@ -103,6 +111,10 @@ class ParticleSet:
             "kxx": 0.0,
             "kxy": 0.0,
             "kyy": 0.0,
+            "dudx": 0.0,
+            "dudy": 0.0,
+            "dvdx": 0.0,
+            "dvdy": 0.0,
             "level": 0,
             "born": 0,
             "stride": 0,

@@ -62,6 +62,7 @@ import numpy as np
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.errors import InputError
+from floodsph.model.particles import VELOCITY_GRADIENT
 from floodsph.scenario.numerics import SMOOTHING_EXCESS, Numerics
 
 HEXAGON_MARGIN = 1.01
@@ -204,7 +205,7 @@ class Refiner:
         rho = p.rho[rep]
         return dict(x=x, y=y, u=p.u[rep], v=p.v[rep], m=m, rho=rho, h=h, h0=h, rho0=rho,
                     alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, model.steps),
-                    stride=p.stride[rep])
+                    stride=p.stride[rep], **{g: getattr(p, g)[rep] for g in VELOCITY_GRADIENT})
 
     # -- coalescing --------------------------------------------------------------------------
     def merge_pairs(self, model) -> tuple[np.ndarray, np.ndarray]:
@@ -315,8 +316,11 @@ class Refiner:
         out = np.empty((a.size, 7))
         refine.merge_pairs(a, b, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, model.numerics.kappa, out)
         rho, h = out[:, 5], out[:, 6]
+        wa = p.m[a] / (p.m[a] + p.m[b])
+        gradient = {g: wa * getattr(p, g)[a] + (1.0 - wa) * getattr(p, g)[b]
+                    for g in VELOCITY_GRADIENT}
         return dict(x=out[:, 0], y=out[:, 1], u=out[:, 2], v=out[:, 3], m=out[:, 4], rho=rho,
-                    h=h, h0=h, rho0=rho, alpha=2.0 * rho,
+                    h=h, h0=h, rho0=rho, alpha=2.0 * rho, **gradient,
                     level=np.minimum(p.level[a], p.level[b]), born=np.full(a.size, model.steps),
                     stride=np.minimum(p.stride[a], p.stride[b]))
 

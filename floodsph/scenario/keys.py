@@ -268,7 +268,9 @@ NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are 
     KeyDoc("kappa", "number", "Smoothing length over particle spacing, h0 / dx. At 1.2 the "
            "square seeding lattice is a stable state of still water."),
     KeyDoc("stabilisation", "string", "Numerical dissipation: a parameter-free Lax-Friedrichs "
-           "term or a two-shock Riemann pressure.", choices=Stabilisation),
+           "term, a two-shock Riemann pressure, or the Lax-Friedrichs term on velocities "
+           "reconstructed to each pair's midpoint (muscl: sharper bores and fronts, "
+           "docs/reconstruction.md).", choices=Stabilisation),
     KeyDoc("density_tol", "number", "Tolerance of the Newton-Raphson solve for depth and "
            "smoothing length, on |R| / rho."),
     KeyDoc("friction_depth_floor_m", "number", "Depth below which Manning friction is evaluated "

@@ -46,6 +46,7 @@ class Stabilisation(Enum):
 
     LAX_FRIEDRICHS = "lax-friedrichs"
     RIEMANN = "riemann"
+    MUSCL = "muscl"
 
 
 class WallModel(Enum):

@@ -34,7 +34,8 @@ from floodsph.run.atomic_files import atomic_path
 from floodsph.run.folder import CHECKPOINT_DIR
 
 STATE_NAME = "state.pkl"
-FORMAT = 1
+FORMAT = 2
+"""Checkpoint layout; 2 adds the particles' velocity gradient (``floodsph.model.particles``)."""
 _TERRAIN = "terrain"
 
 

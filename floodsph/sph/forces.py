@@ -15,6 +15,12 @@ Option "riemann" (method notes 2.2 C, SWE-SPHysics): g rho_i^2 / (2 rho_w) in th
 term of both particles is replaced by the two-shock Riemann pressure p* = g rho_w d*^2 / 2
 (Toro) of the pair, solved along the pair axis.
 
+Option "muscl": Pi_ij acts on every pair, approaching or receding, with v_ij . x_ij replaced
+by the jump left once both velocities are carried to the pair's midpoint along their
+gradients, limited (:func:`reconstructed_jump`): no dissipation in a linear velocity field,
+the full Lax-Friedrichs-type term across shocks and fronts. Measured in
+``docs/reconstruction.md``.
+
 The pressure part of each pair is renormalised by the mean of the pair's K where the particles
 have left the lattice (``floodsph.sph.consistency``). All these forms are antisymmetric in
 (i, j): internal forces conserve linear momentum exactly. The same loop sums
@@ -61,6 +67,7 @@ from floodsph.walls.sight import SIGHT_SLACK, hides
 
 LAX_FRIEDRICHS = 0
 RIEMANN = 1
+MUSCL = 2
 
 
 @njit(inline="always", cache=True)
@@ -83,13 +90,14 @@ def riemann_pressure(d_l, d_r, u_l, u_r):
 
 
 @njit(parallel=True, cache=True)
-def pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, coef):
+def pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, dudx, dudy, dvdx, dvdy, coef):
     """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i, g A_i / 2,
-    K_i xx, xy, yy).
+    K_i xx, xy, yy, G_i xx, xy, yx, yy).
 
     beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
     1 / h_i [m^-1], g A_i / 2 [m3 s-2] with the area A_i = m_i / rho_i, and the pressure
-    renormalisation K_i [-] of ``floodsph.sph.consistency``. A particle with no
+    renormalisation K_i [-] of ``floodsph.sph.consistency``, and the velocity gradient
+    G_i = (du/dx, du/dy; dv/dx, dv/dy) [s-1] of the last force evaluation. A particle with no
     neighbour within its support (alpha_i = 0, possible when its h is held back by its lists)
     takes beta_i = 1, the uncorrected force (alpha_i = 2 rho_i on a lattice).
     """
@@ -101,18 +109,24 @@ def pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, coef):
         coef[i, 4] = kxx[i]
         coef[i, 5] = kxy[i]
         coef[i, 6] = kyy[i]
+        coef[i, 7] = dudx[i]
+        coef[i, 8] = dudy[i]
+        coef[i, 9] = dvdx[i]
+        coef[i, 10] = dvdy[i]
 
 
 @njit(inline="always", cache=True)
-def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, kj, image=False):
+def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, kj, gj, image=False):
     """Pair terms of a_i^int and of div v_i for separation r = x_i - x_j, v = v_i - v_j.
 
     j's properties (mass, density, h, ``coef`` of :func:`pair_coefficients`) are taken at
     index j, also for j's mirror images (whose r and v the caller passes), except j's
-    pressure renormalisation ``kj`` = (K xx, xy, yy), reflected with the image. Returns
-    (rx, ry, fx, fy, w, fd, af), summed by :func:`_subtract`: a_i^int takes - (fx, fy), the
-    pressure part f_p r renormalised to f_p (I + (K_i + K_j) / 2) r
-    (``floodsph.sph.consistency``) plus the shock-capturing part f_v r; the divergence sum
+    pressure renormalisation ``kj`` = (K xx, xy, yy), reflected with the image, and its
+    velocity gradient ``gj`` (xx, xy, yx, yy; zeros for an image, which keeps the raw jump
+    under "muscl"). Returns (rx, ry, fx, fy, w, fd, af), summed by
+    :func:`_subtract`: a_i^int takes - (fx, fy), the pressure part f_p r renormalised to
+    f_p (I + (K_i + K_j) / 2) r (``floodsph.sph.consistency``) plus the shock-capturing part
+    f_v r; the divergence sum
     sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i) takes - fd; and
     w = (g / 2) (m_j / rho_j) (beta_i F_i + beta_j F_j) [s-2 m-2] (F = (1/r) dW/dr) is the
     pair's hydrostatic weight, for the sums of ``floodsph.sph.shore`` and
@@ -138,10 +152,16 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, kj, image=False):
                               + coef[j, 0] * fj / (rho[j] * rho[j]))
         fv = 0.0
     else:
-        # Pi_ij for approaching pairs, computed for all and zero otherwise (no jump)
+        # Pi_ij for approaching pairs, computed for all and zero otherwise (no jump); with
+        # "muscl" for every pair, from the limited jump at the midpoint
         hbar = 0.5 * (h[i] + h[j])
         cbar = 0.5 * (coef[i, 1] + coef[j, 1])
-        pi_ij = -cbar * min(vr, 0.0) / (0.5 * (rho[i] + rho[j])
+        if scheme == MUSCL:
+            jump = reconstructed_jump(rx, ry, vr, coef[i, 7], coef[i, 8], coef[i, 9],
+                                      coef[i, 10], gj)
+        else:
+            jump = min(vr, 0.0)
+        pi_ij = -cbar * jump / (0.5 * (rho[i] + rho[j])
                                         * math.sqrt(r2 + 0.01 * hbar * hbar))
         fp = m[j] * (0.5 * GRAVITY / RHO_WATER) * (coef[i, 0] * fi + coef[j, 0] * fj)
         fv = m[j] * 0.5 * pi_ij * (fi + fj)
@@ -154,9 +174,38 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, kj, image=False):
             m[j] * fi * vr, m[j] / rho[j] * fi)
 
 
+@njit(inline="always", cache=True)
+def reconstructed_jump(rx, ry, vr, gxx, gxy, gyx, gyy, gj):
+    """(v_i* - v_j*) . r [m2 s-1]: the pair's velocity jump with both velocities carried to the
+    pair's midpoint along their limited gradients (a MUSCL-type reconstruction in the
+    dissipative term only, as in Frontiere, Raskin & Owen 2017, J. Comput. Phys. 332, 160-209,
+    and Rosswog 2020, ApJ 898, 60):
+
+        v_i* = v_i - (phi / 2) G_i r,   v_j* = v_j + (phi / 2) G_j r,   r = x_i - x_j,
+        (v_i* - v_j*) . r = vr - (phi / 2) (s_i + s_j),   s_k = r . G_k r,
+        phi = min(1, 4 A / (1 + A)^2),  A = s_i / s_j > 0  (van Leer's limiter; phi = 0 when
+        the two slopes differ in sign),
+
+    G = (gxx, gxy; gyx, gyy) = (du/dx, du/dy; dv/dx, dv/dy) [s-1] being i's and ``gj`` j's
+    (``floodsph.sph.velocity_gradient``).
+    In a linear velocity field s_i = s_j = vr and the jump vanishes; where the two slopes
+    differ (a shock, a front, particle noise) phi falls and the raw jump vr returns. A
+    reconstructed jump of the other sign than vr is taken as 0, so that the term never
+    feeds the relative motion (its dissipation rate, proportional to - jump * vr, stays >= 0).
+    """
+    s_i = rx * (gxx * rx + gxy * ry) + ry * (gyx * rx + gyy * ry)
+    s_j = rx * (gj[0] * rx + gj[1] * ry) + ry * (gj[2] * rx + gj[3] * ry)
+    if s_i * s_j <= 0.0:
+        return vr
+    a = s_i / s_j
+    phi = min(1.0, 4.0 * a / ((1.0 + a) * (1.0 + a)))
+    jump = vr - 0.5 * phi * (s_i + s_j)
+    return jump if jump * vr > 0.0 else 0.0
+
+
 @njit(parallel=True, cache=True)
-def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nstart, nbr, blocked,
-                          walls, scheme, sums, ax, ay, divv):
+def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, dudx, dudy, dvdx,
+                          dvdy, nstart, nbr, blocked, walls, scheme, sums, ax, ay, divv):
     """a^int and div v of the particles ``rows`` (gather form), mirror images included.
 
     Listed neighbours beyond the support 2 max(h_i, h_j) are skipped (no force there); pairs
@@ -170,11 +219,12 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nst
     :func:`_subtract` (its terms 2-8, then 10-11, as the named columns of
     ``floodsph.sph.sums``), for ``floodsph.sph.shore`` and ``floodsph.sph.consistency``; the
     pressure renormalisation K (kxx, kxy, kyy) is the one the latter set from them at i's
-    previous force evaluation.
+    previous force evaluation. "muscl" reconstructs with the velocity gradient (dudx, dudy,
+    dvdx, dvdy) of ``floodsph.sph.velocity_gradient``, current for the particles ``rows``.
     """
     seg, wdist, wstart, wseg, cstart, cpair = walls
-    coef = np.empty((x.shape[0], 7))
-    pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, coef)
+    coef = np.empty((x.shape[0], 11))
+    pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, dudx, dudy, dvdx, dvdy, coef)
     for k in prange(rows.shape[0]):
         i = rows[k]
         xi = x[i]
@@ -192,7 +242,9 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, nst
                 continue
             acc = _subtract(acc, i, j, rho, pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m,
                                                        rho, h, coef, scheme,
-                                                       (coef[j, 4], coef[j, 5], coef[j, 6])))
+                                                       (coef[j, 4], coef[j, 5], coef[j, 6]),
+                                                       (coef[j, 7], coef[j, 8], coef[j, 9],
+                                                        coef[j, 10])))
         # each near segment's single images, then the corners it opens, in list order; one
         # call site, so that the image terms are compiled once into this kernel
         w = wstart[i]
@@ -273,7 +325,7 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
         if ok:
             acc = _subtract(acc, i, j, rho, pair_force(x[i] - xm, y[i] - ym, u[i] - um,
                                                        v[i] - vm, i, j, m, rho, h, coef, scheme,
-                                                       kj, image=j == i))
+                                                       kj, (0.0, 0.0, 0.0, 0.0), image=j == i))
     return acc
 
 

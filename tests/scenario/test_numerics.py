@@ -76,7 +76,7 @@ def test_the_dem_cell_size_fills_in_a_missing_particle_spacing(write_scenario):
         ({"particle_spacing_m": 0.0}, "numerics.particle_spacing_m: must be > 0, got 0"),
         ({"stabilisation": "riemann"}, "numerics.stabilisation: expected a "
                                        "floodsph.scenario.numerics.Stabilisation "
-                                       "('lax-friedrichs', 'riemann'), got 'riemann'"),
+                                       "('lax-friedrichs', 'riemann', 'muscl'), got 'riemann'"),
     ],
 )
 def test_numerics_built_in_code_are_checked_as_a_scenario_is(settings, message):

@@ -14,7 +14,8 @@ def variational_acceleration(model):
     p = model.particles
     ax, ay, divv = np.empty(p.n), np.empty(p.n), np.empty(p.n)
     forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
-                                 p.kxx, p.kxy, p.kyy, model.nl.start, model.nl.nbr, model.blocked,
+                                 p.kxx, p.kxy, p.kyy, p.dudx, p.dudy, p.dvdx, p.dvdy,
+                                 model.nl.start, model.nl.nbr, model.blocked,
                                  model.wall_lists(), model.scheme, np.empty((p.n, SUMS)), ax,
                                  ay, divv)
     forces.add_bed_acceleration(model.nl.rows, p.u, p.v, model.bed, model.numerics.max_slope,

@@ -250,7 +250,8 @@ def test_segments_beyond_reach_are_skipped_without_changing_density_or_forces():
                for i in range(p.n)]
         acc = np.empty((3, p.n))
         forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
-                                     p.kxx, p.kxy, p.kyy, model.nl.start, model.nl.nbr,
+                                     p.kxx, p.kxy, p.kyy, p.dudx, p.dudy, p.dvdx, p.dvdy,
+                                     model.nl.start, model.nl.nbr,
                                      model.blocked, walls, model.scheme, np.empty((p.n, SUMS)),
                                      *acc)
         return np.array(rho), acc

@@ -251,7 +251,7 @@ def malpasset_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("malpasset")
     # two global steps: the tests below count them and bound the time they cover
     cost = mp_run.run_variant(DATA, out, "particles", max_steps=2, progress=False,
-                              time_stepping="global")
+                              numerics={"time_stepping": "global"})
     mp_run.summarise(out)
     return out, cost
 

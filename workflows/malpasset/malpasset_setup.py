@@ -167,12 +167,12 @@ def write_gauges(points: list[dict], path: Path) -> Path:
 
 def scenario_dict(dem: str, bounds, sea: str, end_time: float, spacing: float,
                   gauges: str | None = None, gauge_interval: float = 5.0,
-                  sea_outline_ring: list | None = None, refinement: str | None = None,
-                  time_stepping: str | None = None) -> dict:
+                  sea_outline_ring: list | None = None, numerics: dict | None = None) -> dict:
     """The Malpasset scenario (scenario-format.md) as plain data for ``tomli_w.dumps``.
 
     ``sea`` is one of SEA_MODES; ``"sink"`` needs ``sea_outline_ring`` (:func:`sea_outline`).
-    ``refinement`` and ``time_stepping`` set those ``numerics`` keys (default: floodsph's).
+    ``numerics``: further keys of the ``[numerics]`` table, such as ``refinement`` (default:
+    floodsph's).
     """
     if sea not in SEA_MODES:
         raise ValueError(f"sea must be one of {SEA_MODES}, got {sea!r}")
@@ -195,17 +195,12 @@ def scenario_dict(dem: str, bounds, sea: str, end_time: float, spacing: float,
         out["sinks"] = [{"polygon": sea_outline_ring}]
     if gauges is not None:
         out["gauges"] = {"file": gauges, "interval_s": float(gauge_interval)}
-    out["numerics"] = {"particle_spacing_m": float(spacing)}
-    if refinement is not None:
-        out["numerics"]["refinement"] = refinement
-    if time_stepping is not None:
-        out["numerics"]["time_stepping"] = time_stepping
+    out["numerics"] = {"particle_spacing_m": float(spacing), **(numerics or {})}
     return out
 
 
 def write_scenario(folder: Path, out: Path, sea: str, end_time: float, spacing: float,
-                   gauge_interval: float = 5.0, refinement: str | None = None,
-                   time_stepping: str | None = None) -> Path:
+                   gauge_interval: float = 5.0, numerics: dict | None = None) -> Path:
     """``out/malpasset.toml`` (absolute paths to the data) and ``out/gauges_epsg27572.csv``."""
     from tomli_w import dumps
 
@@ -214,8 +209,7 @@ def write_scenario(folder: Path, out: Path, sea: str, end_time: float, spacing: 
     ring = sea_outline(folder) if sea == "sink" else None
     data = scenario_dict(str(folder / DEM_NAME), dem_bounds(folder), sea, end_time, spacing,
                          gauges=str(gauges), gauge_interval=gauge_interval,
-                         sea_outline_ring=ring, refinement=refinement,
-                         time_stepping=time_stepping)
+                         sea_outline_ring=ring, numerics=numerics)
     path = out / "malpasset.toml"
     path.write_text(dumps(data), encoding="utf-8")
     return path

@@ -18,7 +18,8 @@ Results folder (default ``workflows/malpasset/results``):
   point / per mode) and ``particles.png`` (particle count and wall time against time).
 
 Usage: ``python workflows/malpasset/run_malpasset.py [--sea particles|sink|both]
-[--end-time S] [--spacing M] [--refinement MODE] [--time-stepping global|local] [--out DIR]
+[--end-time S] [--spacing M] [--refinement MODE] [--time-stepping global|local]
+[--stabilisation lax-friedrichs|riemann|muscl] [--out DIR]
 [--overwrite] [--max-steps N]``
 """
 
@@ -45,16 +46,16 @@ PARTICLE_COUNT_INTERVAL_S = 10.0
 def run_variant(folder: Path, out: Path, sea: str, end_time: float = setup.END_TIME_S,
                 spacing: float = 20.0, gauge_interval: float = 5.0, overwrite: bool = False,
                 max_steps: int | None = None, progress: bool = True,
-                threads: int | None = None, refinement: str | None = None,
-                time_stepping: str | None = None) -> dict:
-    """Write, run and report one sea mode in ``out/<sea>/``; returns its cost row."""
+                threads: int | None = None, numerics: dict | None = None) -> dict:
+    """Write, run and report one sea mode in ``out/<sea>/``; returns its cost row.
+    ``numerics``: keys of the scenario's ``[numerics]`` to set (default: floodsph's)."""
     from floodsph.run.pipeline import run_scenario
     from floodsph.scenario.reader import load_scenario
     from floodsph.simulation.schedules import TimeInterval
 
     where = out / sea
     path = setup.write_scenario(folder, where, sea, end_time, spacing, gauge_interval,
-                                refinement, time_stepping)
+                                numerics)
     counter = results.ParticleCounter()
     run_dir = where / "run"
     run_scenario(load_scenario(path), out_dir=run_dir, overwrite=overwrite, progress=progress,
@@ -115,6 +116,12 @@ def _print(points: list[dict], costs: list[dict]) -> None:
             + f"{float(p['arrival_time_s']):>9.0f}")
 
 
+def _numerics(args) -> dict:
+    """The ``[numerics]`` keys the command line sets."""
+    keys = ("refinement", "time_stepping", "stabilisation")
+    return {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+
+
 def _child(args, sea: str) -> int:
     """Run one sea mode in a new process (its own peak memory); its exit status."""
     cmd = [sys.executable, str(Path(__file__).resolve()), "--sea", sea, "--no-summary",
@@ -123,8 +130,8 @@ def _child(args, sea: str) -> int:
     cmd += ["--overwrite"] if args.overwrite else []
     cmd += ["--max-steps", str(args.max_steps)] if args.max_steps else []
     cmd += ["--threads", str(args.threads)] if args.threads is not None else []
-    cmd += ["--refinement", args.refinement] if args.refinement else []
-    cmd += ["--time-stepping", args.time_stepping] if args.time_stepping else []
+    for key, value in _numerics(args).items():
+        cmd += ["--" + key.replace("_", "-"), value]
     return subprocess.run(cmd, check=False).returncode
 
 
@@ -147,6 +154,8 @@ def main(argv=None) -> int:
                         default=None, help="numerics.refinement (default: floodsph's)")
     parser.add_argument("--time-stepping", choices=("global", "local"), default=None,
                         help="numerics.time_stepping (default: floodsph's, local)")
+    parser.add_argument("--stabilisation", choices=("lax-friedrichs", "riemann", "muscl"),
+                        default=None, help="numerics.stabilisation (default: floodsph's)")
     parser.add_argument("--no-summary", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--write-static", action="store_true",
                         help="(re)write workflows/malpasset/scenario.toml and exit")
@@ -174,8 +183,7 @@ def main(argv=None) -> int:
         try:
             run_variant(folder, args.out, args.sea, args.end_time, args.spacing,
                         args.gauge_interval, args.overwrite, args.max_steps,
-                        threads=args.threads, refinement=args.refinement,
-                        time_stepping=args.time_stepping)
+                        threads=args.threads, numerics=_numerics(args))
         except InputError as exc:
             print(f"Error: {exc}", file=sys.stderr)
             return 2
