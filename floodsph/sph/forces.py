@@ -97,7 +97,8 @@ def pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, dudx, dudy, dvdx, dvdy, c
     beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
     1 / h_i [m^-1], g A_i / 2 [m3 s-2] with the area A_i = m_i / rho_i, and the pressure
     renormalisation K_i [-] of ``floodsph.sph.consistency``, and the velocity gradient
-    G_i = (du/dx, du/dy; dv/dx, dv/dy) [s-1] of the last force evaluation. A particle with no
+    G_i = (du/dx, du/dy; dv/dx, dv/dy) [s-1] of the last force evaluation (only when ``coef``
+    has its 11 columns: the "muscl" stabilisation's; the others take 7). A particle with no
     neighbour within its support (alpha_i = 0, possible when its h is held back by its lists)
     takes beta_i = 1, the uncorrected force (alpha_i = 2 rho_i on a lattice).
     """
@@ -109,10 +110,11 @@ def pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, dudx, dudy, dvdx, dvdy, c
         coef[i, 4] = kxx[i]
         coef[i, 5] = kxy[i]
         coef[i, 6] = kyy[i]
-        coef[i, 7] = dudx[i]
-        coef[i, 8] = dudy[i]
-        coef[i, 9] = dvdx[i]
-        coef[i, 10] = dvdy[i]
+        if coef.shape[1] > 7:
+            coef[i, 7] = dudx[i]
+            coef[i, 8] = dudy[i]
+            coef[i, 9] = dvdx[i]
+            coef[i, 10] = dvdy[i]
 
 
 @njit(inline="always", cache=True)
@@ -175,6 +177,15 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, kj, gj, image=Fals
 
 
 @njit(inline="always", cache=True)
+def _gradient(coef, j, scheme):
+    """j's velocity gradient (xx, xy, yx, yy) [s-1] from ``coef`` under "muscl"; zeros for the
+    other schemes, whose ``coef`` has no such columns."""
+    if scheme == MUSCL:
+        return (coef[j, 7], coef[j, 8], coef[j, 9], coef[j, 10])
+    return (0.0, 0.0, 0.0, 0.0)
+
+
+@njit(inline="always", cache=True)
 def reconstructed_jump(rx, ry, vr, gxx, gxy, gyx, gyy, gj):
     """(v_i* - v_j*) . r [m2 s-1]: the pair's velocity jump with both velocities carried to the
     pair's midpoint along their limited gradients (a MUSCL-type reconstruction in the
@@ -223,7 +234,7 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, dud
     dvdx, dvdy) of ``floodsph.sph.velocity_gradient``, current for the particles ``rows``.
     """
     seg, wdist, wstart, wseg, cstart, cpair = walls
-    coef = np.empty((x.shape[0], 11))
+    coef = np.empty((x.shape[0], 11 if scheme == MUSCL else 7))
     pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, dudx, dudy, dvdx, dvdy, coef)
     for k in prange(rows.shape[0]):
         i = rows[k]
@@ -243,8 +254,7 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, dud
             acc = _subtract(acc, i, j, rho, pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m,
                                                        rho, h, coef, scheme,
                                                        (coef[j, 4], coef[j, 5], coef[j, 6]),
-                                                       (coef[j, 7], coef[j, 8], coef[j, 9],
-                                                        coef[j, 10])))
+                                                       _gradient(coef, j, scheme)))
         # each near segment's single images, then the corners it opens, in list order; one
         # call site, so that the image terms are compiled once into this kernel
         w = wstart[i]
