@@ -108,8 +108,11 @@ def load_checkpoint(directory: Path, terrain) -> Checkpoint:
             checkpoint = _Unpickler(f, terrain).load()
     except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError) as exc:
         raise InputError(f"{path}: the checkpoint cannot be read ({exc})") from None
-    if not isinstance(checkpoint, Checkpoint) or checkpoint.format != FORMAT:
-        raise InputError(f"{path}: not a floodsph checkpoint of format {FORMAT}")
+    if not isinstance(checkpoint, Checkpoint):
+        raise InputError(f"{path}: not a floodsph checkpoint")
+    if checkpoint.format != FORMAT:
+        raise InputError(f"{path}: a checkpoint of format {checkpoint.format}; this floodsph "
+                         f"reads format {FORMAT} only: run the scenario again with --overwrite")
     if checkpoint.floodsph_version != __version__:
         raise InputError(f"{path}: written by floodsph {checkpoint.floodsph_version}, this is "
                          f"{__version__}; resume it with that version")

@@ -127,3 +127,24 @@ def test_resume_refuses_a_changed_scenario_and_a_folder_without_checkpoint(dam_b
     # Nothing was touched by the refusal: the interrupted run resumes as it was.
     assert json.loads((out / "run.json").read_text())["status"] == "interrupted"
     assert run(scenario, out, resume=True)["status"] == "completed"
+
+
+def test_resume_refuses_a_checkpoint_of_another_format_and_leaves_the_run(dam_break, tmp_path,
+                                                                           monkeypatch):
+    """A checkpoint written by a floodsph whose particles carried other fields (its format
+    differs) is refused with one message naming the file and both formats; the folder keeps
+    its interrupted run."""
+    from floodsph.errors import InputError
+    from floodsph.simulation import checkpoint
+
+    scenario = dam_break()
+    out = tmp_path / "run"
+    assert run(scenario, out, stop_at=5)["status"] == "interrupted"
+    saved = (out / "checkpoint" / "state.pkl").read_bytes()
+    monkeypatch.setattr(checkpoint, "FORMAT", checkpoint.FORMAT + 1)
+    with pytest.raises(InputError, match=rf"state\.pkl: a checkpoint of format "
+                                         rf"{checkpoint.FORMAT - 1}; this floodsph reads "
+                                         rf"format {checkpoint.FORMAT} only"):
+        run(scenario, out, resume=True)
+    assert json.loads((out / "run.json").read_text())["status"] == "interrupted"
+    assert (out / "checkpoint" / "state.pkl").read_bytes() == saved
