@@ -452,7 +452,7 @@ def run_benchmark(args) -> Benchmark:
     load0 = os.getloadavg()[0]
     kinds = args.cases or [k for k in KINDS if not (args.quick and k == "malpasset")]
     runs = []
-    numerics = {k: getattr(args, k) for k in ("wall_model", "stabilisation")
+    numerics = {k: getattr(args, k) for k in ("wall_model", "stabilisation", "momentum")
                 if getattr(args, k)}
     for case in build_cases(kinds, args.out / "scenarios", args.quick, end_times(args)):
         if numerics:
@@ -606,6 +606,8 @@ def parse_args(argv=None):
     ap.add_argument("--stabilisation", choices=("lax-friedrichs", "riemann", "muscl"),
                     help="[numerics] stabilisation of every case (default: the scenario "
                     "default)")
+    ap.add_argument("--momentum", choices=("variational", "balanced"),
+                    help="[numerics] momentum of every case (default: the scenario default)")
     ap.add_argument("--out", type=Path, default=Path("results/still_water"))
     ap.add_argument("--doc", type=Path, help="the report (default docs/still-water.md; with "
                     "--quick <out>/still-water.md)")

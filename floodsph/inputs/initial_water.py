@@ -257,16 +257,30 @@ def seed_particles(
     d_cells = np.where(terrain.valid if wet is None else wet,
                        np.nan_to_num(depth_grid, nan=0.0), 0.0)
     xs, ys, d = lattice_depth(terrain, d_cells, dx)
+    level = seeded_level(terrain, d_cells, dx)
     d = lump_thin_cells(d)
     li, ki = np.nonzero(d > d_min)
     depth = d[li, ki]
     if particles is None:
         particles = ParticleSet(capacity=max(2 * depth.size, 1024))
-    return particles_at(xs[ki], ys[li], depth, dx, kappa, particles=particles)
+    return particles_at(xs[ki], ys[li], depth, dx, kappa, particles=particles,
+                        eta_seed=level[li, ki])
+
+
+def seeded_level(terrain: Terrain, depth_grid: np.ndarray, dx: float) -> np.ndarray:
+    """The water level [m] of each lattice cell of spacing ``dx``: the area mean of d + z over
+    its wet DEM cells (d > 0), NaN where it has none (the level a particle seeded at rest
+    carries under the balanced momentum, ``floodsph.sph.level_offsets``)."""
+    wet = (depth_grid > 0.0).astype(np.float64)
+    z = np.nan_to_num(np.asarray(terrain.elevation, dtype=np.float64), nan=0.0)
+    _, _, area = lattice_depth(terrain, wet, dx)
+    _, _, volume = lattice_depth(terrain, wet * (depth_grid + z), dx)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(area > 0.0, volume / area, np.nan)
 
 
 def particles_at(x, y, d, dx: float, kappa: float, u=0.0, v=0.0, d_min: float = 0.0,
-                 particles: ParticleSet | None = None) -> ParticleSet:
+                 particles: ParticleSet | None = None, eta_seed=np.nan) -> ParticleSet:
     """Water particles at the lattice nodes (x, y) [m, local] of spacing dx [m] where the depth
     d [m] exceeds ``d_min``: the one seeding convention of runs, verification cases and tests.
 
@@ -283,5 +297,6 @@ def particles_at(x, y, d, dx: float, kappa: float, u=0.0, v=0.0, d_min: float = 
         particles.append(x=x[keep], y=y[keep], m=RHO_WATER * d[keep] * dx**2,
                          rho=RHO_WATER * d[keep], h=np.full(count, kappa * dx),
                          u=np.broadcast_to(u, x.shape)[keep],
-                         v=np.broadcast_to(v, x.shape)[keep])
+                         v=np.broadcast_to(v, x.shape)[keep],
+                         eta_seed=np.broadcast_to(eta_seed, x.shape)[keep])
     return particles

@@ -13,7 +13,9 @@ step. In order:
 5. neighbour lists and the density solve settle h from the seeding guess
    (``FloodModel.interactions(settle=True)``);
 6. seeds of still water by walls are settled and their masses matched to the seeded depth
-   (``floodsph.model.wall_seeds``); ``model.volume_seed_adjustment`` [m3] is the change;
+   (``floodsph.model.wall_seeds``); ``model.volume_seed_adjustment`` [m3] is the change; under
+   the balanced momentum instead, every particle seeded at rest is given the level offset
+   that makes its level its seeded level (``floodsph.sph.level_offsets``);
 7. the first time step dt = cfl min h / (|v| + c).
 """
 
@@ -79,7 +81,10 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
     model.remove_outside(nodata=not walled)
     rho_seed = model.particles.rho.copy()
     model.interactions(settle=True)
-    model.volume_seed_adjustment = settle_at_walls(model, rho_seed)
+    if model.balanced:
+        model.match_levels()
+    else:
+        model.volume_seed_adjustment = settle_at_walls(model, rho_seed)
     model.dt = model.stable_dt()
     return model
 

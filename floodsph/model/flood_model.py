@@ -27,9 +27,17 @@ from floodsph.constants import RHO_WATER
 from floodsph.model.local_stepping import big_step
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
-from floodsph.scenario.numerics import Numerics, Stabilisation, TimeStepping, WallModel
+from floodsph.scenario.numerics import Momentum, Numerics, Stabilisation, TimeStepping, WallModel
 from floodsph.sph import bed as bedmod
-from floodsph.sph import consistency, density, forces, shore, time_step
+from floodsph.sph import (
+    consistency,
+    density,
+    forces,
+    level_momentum,
+    level_offsets,
+    shore,
+    time_step,
+)
 from floodsph.sph.cells import CellGrid
 from floodsph.sph.neighbours import NeighbourList
 from floodsph.sph.sums import SUMS
@@ -112,6 +120,8 @@ class FloodModel:
         self.blocked = np.empty(0, dtype=np.bool_)
         self.wdist = np.empty(0)
         self.integral_walls = numerics.wall_model is WallModel.INTEGRAL
+        self.balanced = numerics.momentum is Momentum.BALANCED
+        self.eta = np.empty(0)  # the particles' levels under the balanced momentum [m]
         self._no_images = (None,)  # the integral walls' image-free lists, per list build
         self.walled = np.zeros(0, dtype=np.bool_)
         self._blocked_nl = None
@@ -186,6 +196,8 @@ class FloodModel:
         """Drift every particle by dt (walls reflect), let the open boundaries act, drop what
         left the domain, and advance density and h by the continuity guess."""
         p = self.particles
+        if self.balanced:
+            level_offsets.decay_offsets(p.u, p.v, p.h, dt, p.eta_offset)
         self.counters["wall_reflections"] += int(sight.drift(
             p.x, p.y, p.u, p.v, dt, self.walls_near.wstart, self.walls_near.wseg, self.seg))
         self._nl_here = False
@@ -381,6 +393,9 @@ class FloodModel:
         bedmod.sample_bed(rows, p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
             self.block_pairs()
+        if self.balanced:
+            self._balanced_forces(rows)
+            return
         if self.scheme == forces.MUSCL:
             velocity_gradient(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, self.nl.start,
                               self.nl.nbr, self.blocked, p.dudx, p.dudy, p.dvdx, p.dvdy)
@@ -401,3 +416,31 @@ class FloodModel:
                                  t.elevation, self.pair_sums, self.walled, p.ax, p.ay)
         forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
                                     p.ay)
+
+    def _balanced_forces(self, rows: np.ndarray) -> None:
+        """The balanced momentum's accelerations of the particles ``rows``
+        (``floodsph.sph.level_momentum``), on the levels of all particles."""
+        p = self.particles
+        t = self.terrain
+        if self.eta.shape[0] != p.n:
+            self.eta = np.empty(p.n)
+        level_offsets.levels(p.x, p.y, p.rho, p.eta_offset, t.elevation, t.dx, t.dy, self.eta)
+        level_momentum.balanced_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
+                                             self.eta, self.bed, self.nl.start, self.nl.nbr,
+                                             self.blocked, self.wall_lists(), t.elevation, t.dx,
+                                             t.dy, p.ax, p.ay, p.divv)
+        level_momentum.add_bed_normal(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
+                                      p.ay)
+
+    def match_levels(self) -> int:
+        """Give every particle seeded at rest the level offset that makes its level its seeded
+        level (``floodsph.sph.level_offsets.match_offsets``), and evaluate the forces again;
+        returns the number matched. For the set-up, under the balanced momentum."""
+        p = self.particles
+        t = self.terrain
+        bed = np.empty(p.n)
+        level_offsets.levels(p.x, p.y, np.zeros(p.n), np.zeros(p.n), t.elevation, t.dx, t.dy,
+                             bed)
+        matched = level_offsets.match_offsets(p.eta_seed, p.rho, bed, p.eta_offset)
+        self.interactions()
+        return matched

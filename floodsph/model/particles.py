@@ -38,12 +38,19 @@ FIELDS: dict[str, tuple[type, str]] = {
     "level": (np.int64, "refinement level: number of splits in the particle's ancestry"),
     "born": (np.int64, "step at which the particle was created (split, merge or inflow)"),
     "stride": (np.int64, "local time stepping: own step in finest steps (0: not yet set)"),
+    "eta_offset": (np.float64, "m, level offset o of the balanced momentum, eta = d + b + o "
+                               "(floodsph.sph.level_offsets)"),
+    "eta_seed": (np.float64, "m, the level a particle seeded at rest was seeded at "
+                             "(NaN for water seeded moving, injected or born in the run)"),
     "pid": (np.int64, "unique particle id, never reused"),
 }
 
 VELOCITY_GRADIENT = ("dudx", "dudy", "dvdx", "dvdy")
 """The fields of the velocity gradient (``floodsph.sph.forces.reconstructed_jump``): daughters
 inherit their parent's, a merged particle takes its pair's mass-weighted mean."""
+INHERITED = VELOCITY_GRADIENT + ("eta_offset",)
+"""The fields that daughters inherit from their parent and a merged particle takes as its
+pair's mass-weighted mean: the velocity gradient and the level offset."""
 
 
 class ParticleSet:
@@ -90,7 +97,8 @@ class ParticleSet:
         """Append particles; ``x, y, m, rho, h`` are required, the rest default sensibly.
 
         ``u, v`` default to 0, ``h0``/``rho0`` to the given ``h``/``rho``, ``alpha`` to
-        2 rho (its lattice value), ``hgrow`` to 1, ``level``, ``born`` and ``stride`` to 0.
+        2 rho (its lattice value), ``hgrow`` to 1, ``level``, ``born``, ``stride`` and
+        ``eta_offset`` to 0, ``eta_seed`` to NaN.
         New ids are assigned.
         Returns the slice of the new particles.
         """
@@ -118,6 +126,8 @@ class ParticleSet:
             "level": 0,
             "born": 0,
             "stride": 0,
+            "eta_offset": 0.0,
+            "eta_seed": np.nan,
         }
         start = self.n
         self._reserve(start + count)

@@ -62,8 +62,8 @@ import numpy as np
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.errors import InputError
-from floodsph.model.particles import VELOCITY_GRADIENT
-from floodsph.scenario.numerics import SMOOTHING_EXCESS, Numerics
+from floodsph.model.particles import INHERITED
+from floodsph.scenario.numerics import SMOOTHING_EXCESS, Momentum, Numerics
 
 HEXAGON_MARGIN = 1.01
 """Radius, relative to a parent's hexagon, within which wall segments are tested against the
@@ -73,6 +73,10 @@ RELAX_RATE = 0.2
 EDGE_ALPHA = 0.8
 """Particles with alpha_i < EDGE_ALPHA 2 rho_i (a kernel support short of neighbours: a wet/dry
 edge) are not relaxed (:func:`relax_smoothing`)."""
+STILL_SPEED = 1e-3
+"""Under the balanced momentum, particles slower than this [m s-1] are still water: neither
+split nor merged (a split or merge changes summation depths that their level offsets were
+matched to, ``floodsph.sph.level_offsets``)."""
 SMALL_FRACTION = 0.25
 """A merge candidate below SMALL_FRACTION area_min that finds no fellow candidate is absorbed
 by its nearest particle of any size (:meth:`Refiner._absorptions`): its h is half or less of
@@ -158,6 +162,14 @@ class Refiner:
         model.particles_changed()
         return int(parents.size), int(a.size)
 
+    def still(self, p) -> np.ndarray:
+        """True for the particles of still water, which the balanced momentum holds at rest
+        and refinement leaves alone (slower than ``STILL_SPEED``); none under the variational
+        momentum."""
+        if self.numerics.momentum is not Momentum.BALANCED:
+            return np.zeros(p.n, dtype=bool)
+        return p.u * p.u + p.v * p.v < STILL_SPEED * STILL_SPEED
+
     # -- splitting ---------------------------------------------------------------------------
     def split_candidates(self, model) -> np.ndarray:
         """Indices of the particles to split (criteria in the module docstring)."""
@@ -167,6 +179,7 @@ class Refiner:
         s = self.numerics
         big = (p.m > self.area_max * p.rho) & (p.rho >= RHO_WATER * s.refine_d_min_m)
         big &= p.level < s.refine_max_level
+        big &= ~self.still(p)
         for boundary in getattr(model, "boundaries", ()):
             big &= ~boundary.protected(p.x, p.y)
         idx = np.flatnonzero(big)
@@ -205,7 +218,7 @@ class Refiner:
         rho = p.rho[rep]
         return dict(x=x, y=y, u=p.u[rep], v=p.v[rep], m=m, rho=rho, h=h, h0=h, rho0=rho,
                     alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, model.steps),
-                    stride=p.stride[rep], **{g: getattr(p, g)[rep] for g in VELOCITY_GRADIENT})
+                    stride=p.stride[rep], **{g: getattr(p, g)[rep] for g in INHERITED})
 
     # -- coalescing --------------------------------------------------------------------------
     def merge_pairs(self, model) -> tuple[np.ndarray, np.ndarray]:
@@ -214,7 +227,8 @@ class Refiner:
         (:meth:`_absorptions`; a is the small one)."""
         p = model.particles
         idx = np.flatnonzero((p.m < self.area_min * p.rho)
-                             & (model.steps - p.born >= self.numerics.refine_no_merge_steps))
+                             & (model.steps - p.born >= self.numerics.refine_no_merge_steps)
+                             & ~self.still(p))
         if idx.size:  # the wall test covers the support of the merged particle, too
             reach_h = np.maximum(p.h[idx], model.numerics.kappa
                                  * np.sqrt(2.0 * p.m[idx] / p.rho[idx]))
@@ -317,10 +331,10 @@ class Refiner:
         refine.merge_pairs(a, b, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, model.numerics.kappa, out)
         rho, h = out[:, 5], out[:, 6]
         wa = p.m[a] / (p.m[a] + p.m[b])
-        gradient = {g: wa * getattr(p, g)[a] + (1.0 - wa) * getattr(p, g)[b]
-                    for g in VELOCITY_GRADIENT}
+        inherited = {g: wa * getattr(p, g)[a] + (1.0 - wa) * getattr(p, g)[b]
+                     for g in INHERITED}
         return dict(x=out[:, 0], y=out[:, 1], u=out[:, 2], v=out[:, 3], m=out[:, 4], rho=rho,
-                    h=h, h0=h, rho0=rho, alpha=2.0 * rho, **gradient,
+                    h=h, h0=h, rho0=rho, alpha=2.0 * rho, **inherited,
                     level=np.minimum(p.level[a], p.level[b]), born=np.full(a.size, model.steps),
                     stride=np.minimum(p.stride[a], p.stride[b]))
 

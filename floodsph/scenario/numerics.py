@@ -49,6 +49,15 @@ class Stabilisation(Enum):
     MUSCL = "muscl"
 
 
+class Momentum(Enum):
+    """The pressure and bed forces: the variational form on the summation depth with the bed
+    pointwise (``floodsph.sph.forces``), or the level's renormalised differences, which hold a
+    lake at rest exactly (``floodsph.sph.level_momentum``)."""
+
+    VARIATIONAL = "variational"
+    BALANCED = "balanced"
+
+
 class WallModel(Enum):
     """How walls hold water: mirror images (``floodsph.walls.images``), or the experimental
     boundary integral (``floodsph.walls.shadow``; measured in ``docs/still-water.md``)."""
@@ -113,6 +122,10 @@ class Numerics:
     step_levels : K of local stepping: a big step holds up to 2^K finest steps.
     wall_model : "mirror" (mirror images, the default) or "integral" (the experimental
         boundary integral of ``floodsph.walls.shadow``).
+    momentum : "variational" (the default) or "balanced": -g grad eta as renormalised
+        differences of the free-surface level eta, a lake at rest an exact equilibrium
+        (``floodsph.sph.level_momentum``); with the "lax-friedrichs" stabilisation and
+        "mirror" walls only.
 
     Inner tunables (not scenario keys):
 
@@ -144,6 +157,7 @@ class Numerics:
     time_stepping: TimeStepping = _setting(TimeStepping.LOCAL, TimeStepping)
     step_levels: int = _setting(3, int, ge=0, le=6)
     wall_model: WallModel = _setting(WallModel.MIRROR, WallModel)
+    momentum: Momentum = _setting(Momentum.VARIATIONAL, Momentum)
     density_max_iter: int = _setting(20, int, ge=1, scenario=False)
     h_ratio: float = _setting(10.0, float, ge=1.0, scenario=False)
     neighbour_skin: float = _setting(0.1, float, ge=0.0, scenario=False)
@@ -164,6 +178,13 @@ class Numerics:
                 "refine_area_min", f"must be below refine_area_max / 2 = "
                 f"{self.refine_area_max / 2.0:g} so that a merged pair is not split again "
                 f"at once; got {self.refine_area_min:g}")
+        if self.momentum is Momentum.BALANCED:
+            if self.stabilisation is not Stabilisation.LAX_FRIEDRICHS:
+                raise NumericsError("momentum", "\"balanced\" takes stabilisation = "
+                                    f"\"lax-friedrichs\", got \"{self.stabilisation.value}\"")
+            if self.wall_model is not WallModel.MIRROR:
+                raise NumericsError("momentum", "\"balanced\" takes wall_model = \"mirror\", "
+                                    f"got \"{self.wall_model.value}\"")
 
 
 def _problem(value, meta) -> str | None:

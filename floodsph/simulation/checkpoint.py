@@ -34,8 +34,9 @@ from floodsph.run.atomic_files import atomic_path
 from floodsph.run.folder import CHECKPOINT_DIR
 
 STATE_NAME = "state.pkl"
-FORMAT = 2
-"""Checkpoint layout; 2 adds the particles' velocity gradient (``floodsph.model.particles``)."""
+FORMAT = 3
+"""Checkpoint layout; 2 adds the particles' velocity gradient, 3 their level offset and seeded
+level (``floodsph.model.particles``)."""
 _TERRAIN = "terrain"
 
 

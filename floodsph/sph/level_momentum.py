@@ -1,0 +1,294 @@
+"""The balanced momentum: the free-surface level's gradient as renormalised level differences.
+
+``numerics.momentum = "balanced"``. With the level eta = d + b + o (d = rho / rho_w the
+summation depth, b the bilinear bed at the particle, o the particle's level offset,
+``floodsph.sph.level_offsets``), pressure and bed together are -g grad eta (de Saint-Venant), and
+grad eta is the renormalised difference gradient (Randles & Libersky 1996; Bonet & Lok 1999):
+
+    a_i^p = -g N_i^-1 S_i,
+    S_i = sum_j w_ij (eta_j - eta_i) r_ij,   N_i = - sum_j w_ij r_ij r_ij^T,
+    w_ij = (m_j / rho_j) (F(r_ij, h_i) + F(r_ij, h_j)) / 2,   F = (1/r) dW/dr < 0,
+    r_ij = x_i - x_j.
+
+It is exact for a linear level, and zero pair by pair for a level one: a lake whose particles
+all carry the level L is an equilibrium whatever the bed, the particles' arrangement, h, the
+walls or a shore. N_i's eigenvalues are lifted to at least ``N_MIN`` (1 in a full support)
+where the support is nearly one-sided.
+
+Walls: mirror images (``floodsph.walls.images.moving_image``) carry their particle's level
+(the level is continued across the wall, not the depth) and its mirrored velocity.
+
+Free edges. Where the water ends, the missing part of the support is dry ground, whose level
+is the bed b_g there: with e_i = - sum_j w_ij r_ij (0 in a full support) the missing pairs
+add (b_g - eta_i) (-e_i) to S_i and about |e_i| l e^ e^^T to N_i, e^ = e_i / |e_i|,
+l = ``GHOST_REACH`` h_i (which completes N to the identity for a support cut through its
+centre). The ghost acts only where the water really ends, tested at the point
+x_g = x_i + ``COVER_REACH`` h_i e^ beyond the particle, not at the particle (whose own
+Shepard sum stays near 1 even at a front):
+
+    1. no wall lies across [x_i, x_i + 2 h_i e^] (walls hold water through their images);
+    2. the water's Shepard sum at x_g, sum_j (m_j / rho_j) W(|x_g - x_j|, h_j) over i and its
+       unblocked neighbours and their wall images, is below ``COVER_MIN`` (inside the water
+       it is near 1, at a front near 0.5 or less);
+    3. the bed at x_i + 2 h_i e^ lies below eta_i + (v_i . e^)_+^2 / 2g: a still shore on
+       rising ground holds its water.
+
+The ghost's depth: d* = eta_i - b_g where the bed beyond is level or falls (b_g <= b_i), else
+the hydrostatic reconstruction min(max(eta_i + run-up - b_g, 0), d_i) (Audusse et al. 2004,
+SIAM J. Sci. Comput. 25, 2050-2065), b_g the bed at x_i + l e^.
+
+Shock capturing is the Ata & Soulaimani term of ``floodsph.sph.forces`` (approaching pairs,
+antisymmetric). The velocity divergence for the continuity guess of the depth is the one of
+``floodsph.sph.forces``, div v_i = -(2 / alpha_i) sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i).
+
+The bed enters only through the normal-force part of the bed term of Rodriguez-Paz & Bonet
+(2005), :func:`add_bed_normal` (zero at rest). Momentum is conserved only to the gradient's
+consistency: a difference form cannot be both exact for a level and antisymmetric.
+
+Units: accelerations [m s-2], levels and depths [m], rho [kg m-2], m [kg], h and r [m].
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit, prange
+
+from floodsph.constants import GRAVITY, RHO_WATER
+from floodsph.sph.bed import BED, CURV_XX, CURV_XY, CURV_YY, SLOPE_X, SLOPE_Y, elevation_at
+from floodsph.sph.kernels import dwdr_over_r_cubic, w_cubic
+from floodsph.walls.geometry import mirror
+from floodsph.walls.images import moving_image
+from floodsph.walls.sight import SIGHT_SLACK, hides
+
+N_MIN = 0.25
+"""Least eigenvalue of N_i used in its inverse [-] (1 in a full support)."""
+EDGE_MIN = 0.02
+"""|e_i| h_i [-] below which a support is taken as full (no ghost): 0.68 where a straight
+edge runs through the particle, and round-off and lattice noise in the water."""
+GHOST_REACH = 0.733
+"""l / h_i: where the ghost stands beyond the particle; |e| h = 0.682 for a support cut
+through its centre, and N_i then grows along e^ by 0.682 x 0.733 = 0.5, from 0.5 to 1."""
+COVER_REACH = 0.75
+"""|x_g - x_i| / h_i of the point where the ghost tests for water."""
+COVER_MIN = 0.6
+"""Shepard sum at x_g [-] at and above which there is water there (no ghost)."""
+
+
+@njit(inline="always", cache=True)
+def _add_pair(acc, rx, ry, vx, vy, deta, i, j, m, rho, h):
+    """Add the pair of i and j (or j's image) at r = x_i - x_j, v = v_i - v_j, with the level
+    difference deta = eta_j - eta_i [m], to i's sums ``acc``:
+    0-1 shock-capturing acceleration [m s-2], 2-3 S [-], 4-6 -N (xx, xy, yy) [-],
+    7-8 -e (x, y) [m-1], 9 the divergence sum, sum m_j F(r, h_i) (v . r) [kg m-2 s-1]."""
+    r2 = rx * rx + ry * ry
+    if r2 <= 0.0:
+        return acc
+    r = math.sqrt(r2)
+    inv_r = 1.0 / r
+    fi = dwdr_over_r_cubic(r, inv_r, 1.0 / h[i])
+    fj = dwdr_over_r_cubic(r, inv_r, 1.0 / h[j])
+    w = 0.5 * m[j] / rho[j] * (fi + fj)
+    vr = vx * rx + vy * ry
+    fv = 0.0
+    if vr < 0.0:
+        hbar = 0.5 * (h[i] + h[j])
+        cbar = 0.5 * (math.sqrt(GRAVITY * rho[i] / RHO_WATER)
+                      + math.sqrt(GRAVITY * rho[j] / RHO_WATER))
+        pi_ij = -cbar * vr / (0.5 * (rho[i] + rho[j]) * math.sqrt(r2 + 0.01 * hbar * hbar))
+        fv = m[j] * 0.5 * pi_ij * (fi + fj)
+    return (acc[0] - fv * rx, acc[1] - fv * ry, acc[2] + w * deta * rx, acc[3] + w * deta * ry,
+            acc[4] + w * rx * rx, acc[5] + w * rx * ry, acc[6] + w * ry * ry,
+            acc[7] + w * rx, acc[8] + w * ry, acc[9] + m[j] * fi * vr)
+
+
+@njit(inline="always", cache=True)
+def _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, eta, seg, s, s2, ds):
+    """Add the images of i and of its unblocked neighbours about segment s (s2 < 0) or
+    through the corner of s and s2 to i's sums (:func:`_add_pair`); ``ds`` is i's distance
+    to s [m] (0 for a corner): images beyond the pair's support are skipped."""
+    hi = h[i]
+    for q in range(nstart[i] - 1, nstart[i + 1]):
+        if q < nstart[i]:
+            j = i
+            if ds >= 2.0 * hi + SIGHT_SLACK:
+                continue
+        else:
+            j = nbr[q]
+            if blocked[q] or ds >= 2.0 * max(hi, h[j]) + SIGHT_SLACK:
+                continue
+        ok, xm, ym, um, vm = moving_image(x[i], y[i], x[j], y[j], u[j], v[j], seg, s, s2)
+        if ok:
+            acc = _add_pair(acc, x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, eta[j] - eta[i], i,
+                            j, m, rho, h)
+    return acc
+
+
+@njit(inline="always", cache=True)
+def _inverse(nxx, nxy, nyy):
+    """Inverse (xx, xy, yy) of the symmetric 2x2 N with its eigenvalues lifted to at least
+    ``N_MIN``."""
+    half_tr = 0.5 * (nxx + nyy)
+    det = nxx * nyy - nxy * nxy
+    low = half_tr - math.sqrt(max(half_tr * half_tr - det, 0.0))
+    if low < N_MIN:
+        nxx += N_MIN - low
+        nyy += N_MIN - low
+        det = nxx * nyy - nxy * nxy
+    return nyy / det, -nxy / det, nxx / det
+
+
+@njit(inline="always", cache=True)
+def _walled(xi, yi, xf, yf, wstart, wseg, seg, i):
+    """True if one of i's near wall segments lies across the line from x_i to (xf, yf)."""
+    for k in range(wstart[i], wstart[i + 1]):
+        if hides(xi, yi, xf, yf, seg, wseg[k]):
+            return True
+    return False
+
+
+@njit(inline="always", cache=True)
+def _cover(i, gx, gy, nstart, nbr, blocked, x, y, m, rho, h, wstart, wseg, seg):
+    """The water's Shepard sum [-] at (gx, gy): sum_j (m_j / rho_j) W(|x_g - x_j|, h_j) over i
+    and its unblocked neighbours, and over their mirror images about i's near walls that a
+    wall hides from x_g (by a wall the images fill the support, as in the density)."""
+    total = 0.0
+    for q in range(nstart[i] - 1, nstart[i + 1]):
+        j = i if q < nstart[i] else nbr[q]
+        if q >= nstart[i] and blocked[q]:
+            continue
+        vol = m[j] / rho[j]
+        total += vol * w_cubic(math.hypot(gx - x[j], gy - y[j]), h[j])
+        for k in range(wstart[i], wstart[i + 1]):
+            s = wseg[k]
+            xm, ym, _, _, _ = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+            r = math.hypot(gx - xm, gy - ym)
+            if r < 2.0 * h[j] and hides(gx, gy, xm, ym, seg, s):
+                total += vol * w_cubic(r, h[j])
+    return total
+
+
+@njit(inline="always", cache=True)
+def ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x, y, m, rho, h,
+                wstart, wseg, seg, elevation, tdx, tdy):
+    """d* [m] of the dry ghost beyond particle i, whose sums left e = (ex, ey) [m-1]; 0 where
+    the support is full or the water does not end there (module docstring, tests 1-3)."""
+    e = math.sqrt(ex * ex + ey * ey)
+    if e * hi < EDGE_MIN:
+        return 0.0
+    ux = ex / e
+    uy = ey / e
+    xf = xi + 2.0 * hi * ux
+    yf = yi + 2.0 * hi * uy
+    if _walled(xi, yi, xf, yf, wstart, wseg, seg, i):
+        return 0.0
+    gx = xi + COVER_REACH * hi * ux
+    gy = yi + COVER_REACH * hi * uy
+    if _cover(i, gx, gy, nstart, nbr, blocked, x, y, m, rho, h, wstart, wseg, seg) >= COVER_MIN:
+        return 0.0
+    ny, nx = elevation.shape
+    toward = max(u[i] * ux + v[i] * uy, 0.0)
+    run_up = 0.5 * toward * toward / GRAVITY
+    if elevation_at(xf, yf, tdx, tdy, elevation, nx, ny) >= eta[i] + run_up:
+        return 0.0
+    reach = GHOST_REACH * hi
+    b_g = elevation_at(xi + reach * ux, yi + reach * uy, tdx, tdy, elevation, nx, ny)
+    b_i = bed[i, BED]
+    if b_g <= b_i:
+        return max(eta[i] - b_g, 0.0)
+    return min(max(eta[i] + run_up - b_g, 0.0), eta[i] - b_i)
+
+
+@njit(parallel=True, cache=True)
+def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, nbr, blocked,
+                          walls, elevation, tdx, tdy, ax, ay, divv):
+    """a_i = -g N_i^-1 S_i + shock capturing, and div v_i, of the particles ``rows`` (gather
+    form; module docstring), with the neighbour lists, blocked pairs and
+    :class:`~floodsph.walls.index.WallLists` of ``floodsph.sph.forces.internal_acceleration``;
+    ``eta`` [m] the particles' levels, ``bed`` their bed sample (``floodsph.sph.bed``),
+    ``elevation`` the terrain's node grid of spacing (tdx, tdy) [m]."""
+    seg, wdist, wstart, wseg, cstart, cpair = walls
+    for k in prange(rows.shape[0]):
+        i = rows[k]
+        xi = x[i]
+        yi = y[i]
+        hi = h[i]
+        acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        h_reach = hi
+        for q in range(nstart[i], nstart[i + 1]):
+            j = nbr[q]
+            rx = xi - x[j]
+            ry = yi - y[j]
+            h_reach = max(h_reach, h[j])
+            hm = 2.0 * max(hi, h[j])
+            if rx * rx + ry * ry >= hm * hm or blocked[q]:
+                continue
+            acc = _add_pair(acc, rx, ry, u[i] - u[j], v[i] - v[j], eta[j] - eta[i], i, j, m,
+                            rho, h)
+        w = wstart[i]
+        cc = cstart[i]
+        single = True
+        while w < wstart[i + 1]:
+            s = wseg[w]
+            s2 = -1
+            ds = wdist[w]
+            if single:
+                single = False
+                if ds >= 2.0 * h_reach + SIGHT_SLACK:
+                    continue
+            elif cc < cstart[i + 1] and cpair[cc, 0] == s:
+                s2 = cpair[cc, 1]
+                ds = 0.0
+                cc += 1
+            else:
+                w += 1
+                single = True
+                continue
+            acc = _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, eta, seg, s,
+                              s2, ds)
+        nxx = -acc[4]
+        nxy = -acc[5]
+        nyy = -acc[6]
+        sx = acc[2]
+        sy = acc[3]
+        ex = -acc[7]
+        ey = -acc[8]
+        d_ghost = ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x,
+                              y, m, rho, h, wstart, wseg, seg, elevation, tdx, tdy)
+        if d_ghost > 0.0:
+            e = math.sqrt(ex * ex + ey * ey)
+            reach = GHOST_REACH * hi
+            sx -= d_ghost * ex
+            sy -= d_ghost * ey
+            nxx += reach * ex * ex / e
+            nxy += reach * ex * ey / e
+            nyy += reach * ey * ey / e
+        ixx, ixy, iyy = _inverse(nxx, nxy, nyy)
+        ax[i] = acc[0] - GRAVITY * (ixx * sx + ixy * sy)
+        ay[i] = acc[1] - GRAVITY * (ixy * sx + iyy * sy)
+        beta = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
+        divv[i] = -beta * acc[9] / rho[i]
+
+
+
+@njit(parallel=True, cache=True)
+def add_bed_normal(rows, u, v, bed, max_slope, ax, ay):
+    """The normal-force part of the bed term (Rodriguez-Paz & Bonet 2005) for a = -g grad eta:
+
+        a_i <- a_i - [(v.K.v + a_i . grad b) / (1 + |grad b|^2)] grad b,
+
+    K the bed's curvature, the slope limited to ``max_slope``, the factor kept >= -g (a
+    column is not pulled into the bed). Zero at rest."""
+    for k in prange(rows.shape[0]):
+        i = rows[k]
+        bx = bed[i, SLOPE_X]
+        by = bed[i, SLOPE_Y]
+        s = math.sqrt(bx * bx + by * by)
+        if s > max_slope:
+            bx *= max_slope / s
+            by *= max_slope / s
+        vkv = (u[i] * (bed[i, CURV_XX] * u[i] + bed[i, CURV_XY] * v[i])
+               + v[i] * (bed[i, CURV_XY] * u[i] + bed[i, CURV_YY] * v[i]))
+        f = max((vkv + ax[i] * bx + ay[i] * by) / (1.0 + bx * bx + by * by), -GRAVITY)
+        ax[i] -= f * bx
+        ay[i] -= f * by
