@@ -122,6 +122,7 @@ class FloodModel:
         self.integral_walls = numerics.wall_model is WallModel.INTEGRAL
         self.balanced = numerics.momentum is Momentum.BALANCED
         self.eta = np.empty(0)  # the particles' levels under the balanced momentum [m]
+        self.ghost = np.empty(0)  # and their dry ghosts' depths [m] (0: no free edge)
         self._no_images = (None,)  # the integral walls' image-free lists, per list build
         self.walled = np.zeros(0, dtype=np.bool_)
         self._blocked_nl = None
@@ -424,11 +425,12 @@ class FloodModel:
         t = self.terrain
         if self.eta.shape[0] != p.n:
             self.eta = np.empty(p.n)
+            self.ghost = np.zeros(p.n)
         level_offsets.levels(p.x, p.y, p.rho, p.eta_offset, t.elevation, t.dx, t.dy, self.eta)
         level_momentum.balanced_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                              self.eta, self.bed, self.nl.start, self.nl.nbr,
                                              self.blocked, self.wall_lists(), t.elevation, t.dx,
-                                             t.dy, p.ax, p.ay, p.divv)
+                                             t.dy, p.ax, p.ay, p.divv, self.ghost)
         level_momentum.add_bed_normal(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
                                       p.ay)
 

@@ -22,14 +22,15 @@ Free edges. Where the water ends, the missing part of the support is dry ground,
 is the bed b_g there: with e_i = - sum_j w_ij r_ij (0 in a full support) the missing pairs
 add (b_g - eta_i) (-e_i) to S_i and about |e_i| l e^ e^^T to N_i, e^ = e_i / |e_i|,
 l = ``GHOST_REACH`` h_i (which completes N to the identity for a support cut through its
-centre). The ghost acts only where the water really ends, tested at the point
-x_g = x_i + ``COVER_REACH`` h_i e^ beyond the particle, not at the particle (whose own
-Shepard sum stays near 1 even at a front):
+centre). The ghost acts only where |e_i| h_i >= ``EDGE_MIN`` and the water really ends,
+tested at the point x_g = x_i + ``COVER_REACH`` h_i e^ beyond the particle, not at the
+particle (whose own Shepard sum stays near 1 even at a front):
 
     1. no wall lies across [x_i, x_i + 2 h_i e^] (walls hold water through their images);
     2. the water's Shepard sum at x_g, sum_j (m_j / rho_j) W(|x_g - x_j|, h_j) over i and its
        unblocked neighbours and their wall images, is below ``COVER_MIN`` (inside the water
-       it is near 1, at a front near 0.5 or less);
+       it is near 1, at a front near 0.5 or less); water faster than ``EDGE_SPEED`` skips
+       this test, as the rows behind a moving front need the push;
     3. the bed at x_i + 2 h_i e^ lies below eta_i + (v_i . e^)_+^2 / 2g: a still shore on
        rising ground holds its water.
 
@@ -73,6 +74,9 @@ COVER_REACH = 0.75
 """|x_g - x_i| / h_i of the point where the ghost tests for water."""
 COVER_MIN = 0.6
 """Shepard sum at x_g [-] at and above which there is water there (no ghost)."""
+EDGE_SPEED = 0.01
+"""Speed [m s-1] from which a particle's cut support is a free edge without the Shepard-sum
+test (test 2): moving water's rows behind a front need the push."""
 
 
 @njit(inline="always", cache=True)
@@ -182,10 +186,12 @@ def ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x, 
     yf = yi + 2.0 * hi * uy
     if _walled(xi, yi, xf, yf, wstart, wseg, seg, i):
         return 0.0
-    gx = xi + COVER_REACH * hi * ux
-    gy = yi + COVER_REACH * hi * uy
-    if _cover(i, gx, gy, nstart, nbr, blocked, x, y, m, rho, h, wstart, wseg, seg) >= COVER_MIN:
-        return 0.0
+    if u[i] * u[i] + v[i] * v[i] < EDGE_SPEED * EDGE_SPEED:
+        gx = xi + COVER_REACH * hi * ux
+        gy = yi + COVER_REACH * hi * uy
+        if _cover(i, gx, gy, nstart, nbr, blocked, x, y, m, rho, h, wstart, wseg,
+                  seg) >= COVER_MIN:
+            return 0.0
     ny, nx = elevation.shape
     toward = max(u[i] * ux + v[i] * uy, 0.0)
     run_up = 0.5 * toward * toward / GRAVITY
@@ -201,12 +207,13 @@ def ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x, 
 
 @njit(parallel=True, cache=True)
 def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, nbr, blocked,
-                          walls, elevation, tdx, tdy, ax, ay, divv):
+                          walls, elevation, tdx, tdy, ax, ay, divv, ghost):
     """a_i = -g N_i^-1 S_i + shock capturing, and div v_i, of the particles ``rows`` (gather
     form; module docstring), with the neighbour lists, blocked pairs and
     :class:`~floodsph.walls.index.WallLists` of ``floodsph.sph.forces.internal_acceleration``;
     ``eta`` [m] the particles' levels, ``bed`` their bed sample (``floodsph.sph.bed``),
-    ``elevation`` the terrain's node grid of spacing (tdx, tdy) [m]."""
+    ``elevation`` the terrain's node grid of spacing (tdx, tdy) [m]; ``ghost`` receives each
+    particle's ghost depth d* [m] (0: no free edge)."""
     seg, wdist, wstart, wseg, cstart, cpair = walls
     for k in prange(rows.shape[0]):
         i = rows[k]
@@ -255,6 +262,7 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         ey = -acc[8]
         d_ghost = ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x,
                               y, m, rho, h, wstart, wseg, seg, elevation, tdx, tdy)
+        ghost[i] = d_ghost
         if d_ghost > 0.0:
             e = math.sqrt(ex * ex + ey * ey)
             reach = GHOST_REACH * hi

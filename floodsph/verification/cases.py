@@ -104,7 +104,8 @@ class CaseResult:
 
 def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **numerics):
     """A FloodModel on an analytic bed with particles on a lattice of spacing dx where the
-    depth exceeds 1 mm; ``numerics``: fields of its ``Numerics`` (``refinement`` default
+    depth exceeds 1 mm (water seeded at rest carries its level d + b, as in a scenario);
+    ``numerics``: fields of its ``Numerics`` (``refinement`` default
     ``Refinement.NONE``: uniform resolution, another mode adds a refiner; ``time_stepping``
     default ``TimeStepping.GLOBAL``, the step the validation pages' figures were measured
     with)."""
@@ -114,8 +115,11 @@ def _lattice_model(bed, xlim, ylim, cell, depth, dx, kappa, u=0.0, v=0.0, **nume
     X, Y = np.meshgrid(np.arange(dx / 2, terrain.width, dx), np.arange(dx / 2, terrain.height, dx))
     x, y = X.ravel(), Y.ravel()
     xw, yw = x + terrain.x0, y + terrain.y0
-    p = particles_at(x, y, depth(xw, yw), dx, kappa, u=u(xw, yw) if callable(u) else u,
-                     v=v(xw, yw) if callable(v) else v, d_min=1e-3)
+    u0 = np.broadcast_to(u(xw, yw) if callable(u) else u, x.shape)
+    v0 = np.broadcast_to(v(xw, yw) if callable(v) else v, x.shape)
+    d0 = depth(xw, yw)
+    level = np.where((u0 == 0.0) & (v0 == 0.0), d0 + bed(xw, yw), np.nan)
+    p = particles_at(x, y, d0, dx, kappa, u=u0, v=v0, d_min=1e-3, eta_seed=level)
     num = Numerics(particle_spacing_m=dx, kappa=kappa,
                    **{"refinement": Refinement.NONE, "time_stepping": TimeStepping.GLOBAL,
                       **numerics})
