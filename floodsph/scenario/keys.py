@@ -35,7 +35,14 @@ from floodsph.scenario.config import (
     TerrainConfig,
     Wall,
 )
-from floodsph.scenario.numerics import Numerics, Refinement, Stabilisation, TimeStepping, WallModel
+from floodsph.scenario.numerics import (
+    Momentum,
+    Numerics,
+    Refinement,
+    Stabilisation,
+    TimeStepping,
+    WallModel,
+)
 
 POINTS = "array of [x, y]"
 """The type of a list of points in the DEM's CRS."""
@@ -293,6 +300,12 @@ NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are 
            "`mirror`, mirror images of the particles (default); `integral`, the experimental "
            "boundary integral of the kernel support they hide (docs/still-water.md compares "
            "the two).", choices=WallModel),
+    KeyDoc("momentum", "string", "The pressure and bed forces: `variational` (default), the "
+           "variational force on the summation depth with the bed pointwise; `balanced`, the "
+           "free-surface level's renormalised differences, which hold a lake at rest exactly "
+           "by walls, nodata banks and shores (docs/balanced-momentum.md; its dam-break "
+           "fronts lag). Takes stabilisation = \"lax-friedrichs\" and wall_model = "
+           "\"mirror\".", choices=Momentum),
 ))
 
 OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into it.",
