@@ -35,7 +35,7 @@ from floodsph.walls.nodata import settle_seeds
 
 def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, walls=(),
                  closed_edges: bool | tuple[str, ...] = True, boundaries=(),
-                 refiner=None) -> FloodModel:
+                 refiner=None, held=None) -> FloodModel:
     """A FloodModel ready for its first step (module docstring).
 
     Parameters
@@ -56,6 +56,8 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
     boundaries : sequence of floodsph.boundaries.protocol.Boundary
         Open boundaries (inflows, sinks).
     refiner : floodsph.model.refinement.Refiner or None
+    held : (ny, nx) bool array or None
+        The DEM cells that held water at seeding (``FloodModel``).
     """
     if numerics.particle_spacing_m is None:
         raise ValueError("set_up_model: numerics.particle_spacing_m must be given (the "
@@ -74,7 +76,8 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
     seg = model_segments(terrain, walls, closed, walled, openings,
                          numerics.kappa * numerics.particle_spacing_m,
                          numerics.particle_spacing_m)
-    model = FloodModel(terrain, particles, numerics, seg, closed_edges, boundaries, refiner)
+    model = FloodModel(terrain, particles, numerics, seg, closed_edges, boundaries, refiner,
+                       held)
     for boundary in model.boundaries:
         boundary.apply(model, 0.0)
     _seeds_off_walls(model, walled)

@@ -79,6 +79,10 @@ class FloodModel:
     refiner : object or None
         Particle splitting and coalescing: ``apply(model) -> (splits, merges)``, called after
         the boundaries once the particles have moved (``floodsph.model.refinement``).
+    held : (ny, nx) bool array or None
+        The DEM cells that held water at seeding; with the nodata cells, the balanced
+        momentum's still water does not take them for dry land beyond a free edge
+        (``floodsph.sph.level_momentum``). None: the nodata cells only.
 
     Attributes
     ----------
@@ -91,7 +95,7 @@ class FloodModel:
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
                  seg: np.ndarray, closed_edges: bool | tuple[str, ...], boundaries,
-                 refiner=None):
+                 refiner=None, held: np.ndarray | None = None):
         self.terrain = terrain
         self.boundaries = list(boundaries)
         self.refiner = refiner
@@ -121,6 +125,8 @@ class FloodModel:
         self.wdist = np.empty(0)
         self.integral_walls = numerics.wall_model is WallModel.INTEGRAL
         self.balanced = numerics.momentum is Momentum.BALANCED
+        self.held = np.ascontiguousarray(~terrain.valid if held is None else held | ~terrain.valid,
+                                         dtype=np.uint8)
         self.eta = np.empty(0)  # the particles' levels under the balanced momentum [m]
         self.ghost = np.empty(0)  # and their dry ghosts' depths [m] (0: no free edge)
         self._no_images = (None,)  # the integral walls' image-free lists, per list build
@@ -429,8 +435,9 @@ class FloodModel:
         level_offsets.levels(p.x, p.y, p.rho, p.eta_offset, t.elevation, t.dx, t.dy, self.eta)
         level_momentum.balanced_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                              self.eta, self.bed, self.nl.start, self.nl.nbr,
-                                             self.blocked, self.wall_lists(), t.elevation, t.dx,
-                                             t.dy, p.ax, p.ay, p.divv, self.ghost)
+                                             self.blocked, self.wall_lists(), t.elevation,
+                                             self.held, t.dx, t.dy, p.ax, p.ay, p.divv,
+                                             self.ghost)
         level_momentum.add_bed_normal(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
                                       p.ay)
 

@@ -31,6 +31,7 @@ def build_model(scenario: Scenario, inputs):
         closed_edges=_closed_edges(scenario.terrain),
         boundaries=open_boundaries(scenario, inputs, numerics),
         refiner=Refiner.of(numerics),
+        held=inputs.depth > 0.0,
     )
 
 

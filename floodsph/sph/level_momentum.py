@@ -30,8 +30,13 @@ particle (whose own Shepard sum stays near 1 even at a front):
     2. the water's Shepard sum at x_g, sum_j (m_j / rho_j) W(|x_g - x_j|, h_j) over i and its
        unblocked neighbours and their wall images, is below ``COVER_MIN`` (inside the water
        it is near 1, at a front near 0.5 or less); water faster than ``EDGE_SPEED`` skips
-       this test, as the rows behind a moving front need the push;
-    3. the bed at x_i + 2 h_i e^ lies below eta_i + (v_i . e^)_+^2 / 2g: a still shore on
+       this test and the next, as the rows behind a moving front need the push;
+    3. for still water, none of the points x_i + (1, 1.5, 2) h_i e^ lies in a DEM cell that
+       held water at seeding or is nodata, or whose elevation is at or above eta_i: a lake's gaps
+       between the seeded particles and its banks (a lattice cell emptied into a deeper
+       neighbour, the sliver of a walled nodata cell) are not free edges, while the dry
+       ground beyond a dam face is;
+    4. the bed at x_i + 2 h_i e^ lies below eta_i + (v_i . e^)_+^2 / 2g: a still shore on
        rising ground holds its water.
 
 The ghost's depth: d* = eta_i - b_g where the bed beyond is level or falls (b_g <= b_i), else
@@ -173,10 +178,27 @@ def _cover(i, gx, gy, nstart, nbr, blocked, x, y, m, rho, h, wstart, wseg, seg):
 
 
 @njit(inline="always", cache=True)
+def _held_beyond(xi, yi, ux, uy, hi, eta_i, held, elevation, tdx, tdy):
+    """True if one of the points x_i + (1, 1.5, 2) h_i e^ lies in a DEM cell that ``held``
+    marks (water at seeding, or nodata) or whose elevation is at or above the level eta_i [m]
+    (the cell's own value, as the seeding saw it): still water there is held by the seeded
+    water's own banks (module docstring, test 3)."""
+    ny, nx = elevation.shape
+    for reach in (1.0, 1.5, 2.0):
+        px = xi + reach * hi * ux
+        py = yi + reach * hi * uy
+        col = min(max(int(px / tdx), 0), nx - 1)
+        row = min(max(int(py / tdy), 0), ny - 1)
+        if held[row, col] or elevation[row, col] >= eta_i:
+            return True
+    return False
+
+
+@njit(inline="always", cache=True)
 def ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x, y, m, rho, h,
-                wstart, wseg, seg, elevation, tdx, tdy):
+                wstart, wseg, seg, elevation, held, tdx, tdy):
     """d* [m] of the dry ghost beyond particle i, whose sums left e = (ex, ey) [m-1]; 0 where
-    the support is full or the water does not end there (module docstring, tests 1-3)."""
+    the support is full or the water does not end there (module docstring, tests 1-4)."""
     e = math.sqrt(ex * ex + ey * ey)
     if e * hi < EDGE_MIN:
         return 0.0
@@ -191,6 +213,8 @@ def ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x, 
         gy = yi + COVER_REACH * hi * uy
         if _cover(i, gx, gy, nstart, nbr, blocked, x, y, m, rho, h, wstart, wseg,
                   seg) >= COVER_MIN:
+            return 0.0
+        if _held_beyond(xi, yi, ux, uy, hi, eta[i], held, elevation, tdx, tdy):
             return 0.0
     ny, nx = elevation.shape
     toward = max(u[i] * ux + v[i] * uy, 0.0)
@@ -207,12 +231,13 @@ def ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x, 
 
 @njit(parallel=True, cache=True)
 def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, nbr, blocked,
-                          walls, elevation, tdx, tdy, ax, ay, divv, ghost):
+                          walls, elevation, held, tdx, tdy, ax, ay, divv, ghost):
     """a_i = -g N_i^-1 S_i + shock capturing, and div v_i, of the particles ``rows`` (gather
     form; module docstring), with the neighbour lists, blocked pairs and
     :class:`~floodsph.walls.index.WallLists` of ``floodsph.sph.forces.internal_acceleration``;
     ``eta`` [m] the particles' levels, ``bed`` their bed sample (``floodsph.sph.bed``),
-    ``elevation`` the terrain's node grid of spacing (tdx, tdy) [m]; ``ghost`` receives each
+    ``elevation`` the terrain's node grid of spacing (tdx, tdy) [m] and ``held`` its cells
+    that held water at seeding or are nodata (test 4); ``ghost`` receives each
     particle's ghost depth d* [m] (0: no free edge)."""
     seg, wdist, wstart, wseg, cstart, cpair = walls
     for k in prange(rows.shape[0]):
@@ -261,7 +286,7 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         ex = -acc[7]
         ey = -acc[8]
         d_ghost = ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x,
-                              y, m, rho, h, wstart, wseg, seg, elevation, tdx, tdy)
+                              y, m, rho, h, wstart, wseg, seg, elevation, held, tdx, tdy)
         ghost[i] = d_ghost
         if d_ghost > 0.0:
             e = math.sqrt(ex * ex + ey * ey)
