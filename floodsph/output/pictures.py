@@ -246,12 +246,13 @@ def comparison_figure(result):
     s = result.summary
     diff = result.difference
     lim = float(np.nanmax(np.abs(diff))) if np.isfinite(diff).any() else 1.0
-    units = "s" if s["kind"] == "arrival" else ("class" if s["kind"] == "class" else "m")
+    quantity = result.model.quantity
+    units = "class" if quantity.classes else quantity.units
     im = ax2.imshow(diff, cmap="RdBu_r", vmin=-lim, vmax=lim, extent=extent,
                     interpolation="nearest")
     fig.colorbar(im, ax=ax2, label=f"model - reference [{units}]", shrink=0.8)
     _frame(ax1, f"wet/dry agreement: CSI = {s['csi']:.3f}, H = {s['hit_rate']:.3f}")
-    _frame(ax2, f"{s['kind']} difference")
+    _frame(ax2, f"{quantity.name} difference")
     for ax in (ax1, ax2):
         _scale_bar(ax, nx * abs(t.a))
     return fig

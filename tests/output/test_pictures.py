@@ -68,6 +68,7 @@ def test_hazard_class_names_do_not_overlap_each_other_or_the_map(envelopes):
 def test_comparison_legend_stays_clear_of_both_panels():
     from floodsph.output.compare import Comparison
     from floodsph.output.map_source import Raster
+    from floodsph.output.quantities import BY_NAME
 
     categories = np.zeros((40, 60), dtype=np.uint8)
     categories[:, :] = 1
@@ -75,7 +76,7 @@ def test_comparison_legend_stays_clear_of_both_panels():
     categories[10:20, 30:35] = 3
     categories[20:25, 10:30] = 4
     model = Raster("m.tif", np.zeros((40, 60)), from_origin(500000.0, 4200000.0, 10.0, 10.0),
-                   CRS.from_epsg(32633), "depth")
+                   CRS.from_epsg(32633), BY_NAME["depth"])
     summary = {"csi": 0.6, "hit_rate": 0.667, "kind": "depth"}
     fig = comparison_figure(Comparison(summary, np.zeros((40, 60)), categories, model))
     renderer = drawn(fig)
