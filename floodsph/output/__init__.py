@@ -11,12 +11,14 @@ from pathlib import Path
 FORMATS = ("geotiff", "netcdf")
 
 
-def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None) -> list[Path]:
+def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None,
+               start=None) -> list[Path]:
     """Write every envelope map of the run-folder contract.
 
     ``geotiff``: ``<name>.tif`` for each map of :data:`floodsph.output.envelopes.MAPS`;
     ``netcdf``: all of them in ``flood_maps.nc``. The wet threshold and hazard land use are
-    taken from ``envelopes`` and recorded in the files with the resolved ``scenario``.
+    taken from ``envelopes`` and recorded in the files with the resolved ``scenario``; the
+    NetCDF ``time`` counts from ``start`` (a time zone aware datetime, or None).
 
     Returns the written paths.
     """
@@ -53,7 +55,7 @@ def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None
         written.append(write_flood_maps(out_dir / "flood_maps.nc", maps, MAPS, grid,
                                         class_names=class_names, scenario=scenario,
                                         wet_threshold=envelopes.wet_threshold,
-                                        period_s=envelopes.t_last))
+                                        period_s=envelopes.t_last, start=start))
     return written
 
 

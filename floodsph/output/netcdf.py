@@ -16,6 +16,7 @@ Global attributes: ``Conventions``, ``title``, ``source = "floodsph <version>"``
 from __future__ import annotations
 
 import os
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -25,20 +26,21 @@ from floodsph.output.cf import (
     COORD_ATTRS,
     THRESHOLD,
     THRESHOLD_ATTRS,
-    TIME_ATTRS,
     USES_THRESHOLD,
     flag_attrs,
     global_attrs,
     grid_coords,
     grid_mapping_attrs,
     no_fill,
+    time_attrs,
     variable_attrs,
 )
 
 
 def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
                      scenario: dict | None = None, wet_threshold: float = 0.01,
-                     period_s: float | None = None, title: str = "floodsph flood maps") -> Path:
+                     period_s: float | None = None, title: str = "floodsph flood maps",
+                     start: datetime | None = None) -> Path:
     """Write the envelope maps as one CF-1.8 NetCDF file.
 
     Parameters
@@ -60,6 +62,8 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
         with bounds [0, period_s], the interval of the maps' ``cell_methods``.
     scenario, title
         Recorded in the global attributes.
+    start : datetime, optional
+        The calendar instant of t = 0 (``[scenario] start``): ``time`` is seconds since it.
     """
     import xarray as xr
 
@@ -71,7 +75,7 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
     data_vars = {}
     if period_s is not None:
         coords["time"] = xr.Variable((), np.float64(period_s),
-                                     dict(TIME_ATTRS, bounds="time_bounds"))
+                                     dict(time_attrs(start), bounds="time_bounds"))
         data_vars["time_bounds"] = xr.Variable("nv", np.array([0.0, period_s]))
     encoding = no_fill([*coords, *data_vars])
     if crs is not None:
@@ -117,8 +121,8 @@ SNAPSHOT_VARIABLES = {
 class SnapshotWriter:
     """Append depth and velocity maps at successive times to ``snapshots.nc`` (CF-1.8).
 
-    The file has an unlimited ``time`` dimension (seconds since the start of the run, placed
-    at :data:`floodsph.output.cf.TIME_REFERENCE`) and the variables of
+    The file has an unlimited ``time`` dimension (seconds since the start of the run,
+    ``start``: :func:`floodsph.output.cf.time_attrs`) and the variables of
     :data:`SNAPSHOT_VARIABLES` on (time, y, x), NaN where unsupported. Use as a context
     manager or call :meth:`close`. ``keep_frames`` > 0 continues the frames of an earlier
     file, ``source`` (default ``path`` itself; a resumed run): its first ``keep_frames``
@@ -127,7 +131,8 @@ class SnapshotWriter:
     """
 
     def __init__(self, path, grid, *, scenario: dict | None = None,
-                 wet_threshold: float = 0.01, keep_frames: int = 0, source=None):
+                 wet_threshold: float = 0.01, keep_frames: int = 0, source=None,
+                 start: datetime | None = None):
         import netCDF4
 
         self.path = Path(path)
@@ -147,7 +152,7 @@ class SnapshotWriter:
             var.setncatts(COORD_ATTRS[name])
             var[:] = values
         t = ds.createVariable("time", "f8", ("time",), fill_value=False)
-        t.setncatts(TIME_ATTRS)
+        t.setncatts(time_attrs(start))
         crs = grid_mapping_attrs(grid)
         if crs is not None:
             ds.createVariable("crs", "i4", ()).setncatts(crs)

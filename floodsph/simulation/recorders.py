@@ -42,7 +42,8 @@ class Recorders:
         if gauge_points is not None:
             from floodsph.output.gauges import Gauges
 
-            self.gauges = Gauges(gauge_points, scenario.gauges.interval_s, wet_threshold=wet)
+            self.gauges = Gauges(gauge_points, scenario.gauges.interval_s, wet_threshold=wet,
+                                 start=scenario.start)
         self.snapshots = None
         if scenario.output.snapshot_interval_s > 0:
             from floodsph.output.netcdf import SnapshotWriter
@@ -50,7 +51,7 @@ class Recorders:
             self.snapshots = SnapshotWriter(
                 self.out / SNAPSHOTS_PART, self.grid, scenario=scenario.to_dict(),
                 wet_threshold=wet, keep_frames=0 if state is None else state["snapshot_frames"],
-                source=snapshots_from,
+                source=snapshots_from, start=scenario.start,
             )
         if state is not None:
             self.envelopes.restore(state["envelopes"])
@@ -95,7 +96,8 @@ class Recorders:
         from floodsph.output import write_maps
 
         formats = [f.value for f in self.scenario.output.formats]
-        written = write_maps(self.envelopes, into, formats, scenario=self.scenario.to_dict())
+        written = write_maps(self.envelopes, into, formats, scenario=self.scenario.to_dict(),
+                             start=self.scenario.start)
         if self.gauges is not None:
             written.append(self.gauges.write_csv(into / GAUGES_NAME))
         if self.snapshots is not None:

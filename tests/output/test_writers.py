@@ -143,7 +143,7 @@ def test_snapshots_append_along_unlimited_time(terrain, tmp_path):
         w.append(0.0, d, d * 0, d * 0)
         w.append(5.0, d * 2, d * 0 + 1, d * 0)
     with xr.open_dataset(tmp_path / "snapshots.nc") as ds:
-        # seconds since the fixed reference 1970-01-01 (floodsph.output.cf.TIME_REFERENCE)
+        # no start: seconds since the placeholder 1970-01-01 (floodsph.output.cf.NO_START)
         assert list(ds["time"].values) == [np.datetime64("1970-01-01T00:00:00"),
                                            np.datetime64("1970-01-01T00:00:05")]
         assert ds.encoding["unlimited_dims"] == {"time"}
