@@ -40,6 +40,8 @@ def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None
     colours = {"hazard_uk": UK_COLOURS, "hazard_arr": ARR_COLOURS}
     tags = {"wet_threshold_m": envelopes.wet_threshold, "hazard_land_use": tables.land_use,
             "source": f"floodsph {__version__}"}
+    if envelopes.t_last is not None:
+        tags["period_s"] = repr(float(envelopes.t_last))
     written = []
     if "geotiff" in formats:
         from floodsph.output.geotiff import write_geotiff

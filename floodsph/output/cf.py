@@ -133,9 +133,9 @@ def flag_meanings(names) -> str:
 
 
 def flag_attrs(names) -> dict:
-    """``flag_values`` 0..n-1 (:data:`CLASS_DTYPE`) and ``flag_meanings`` of the class names
-    (index = value)."""
-    return {"flag_values": np.arange(len(names), dtype=CLASS_DTYPE),
+    """``flag_values`` 0..n-1 (uint8, as the class maps in memory; the NetCDF writers store
+    both as :data:`CLASS_DTYPE`) and ``flag_meanings`` of the class names (index = value)."""
+    return {"flag_values": np.arange(len(names), dtype=np.uint8),
             "flag_meanings": flag_meanings(names)}
 
 
