@@ -61,12 +61,13 @@ def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None
     return written
 
 
-def write_pictures(envelopes, out_dir, title: str = "") -> list[Path] | str:
-    """Quick-look PNGs of the envelopes (see :mod:`floodsph.output.pictures`).
+def write_pictures(envelopes, out_dir, title: str = "", features=None) -> list[Path] | str:
+    """Quick-look PNGs of the envelopes, with the walls, sinks, gauges and caption of
+    ``features`` (see :mod:`floodsph.output.pictures`).
 
     Returns the written paths, or the message ``"pictures skipped: matplotlib not
     installed"``.
     """
     from floodsph.output.pictures import write_pictures as _write
 
-    return _write(envelopes, out_dir, title)
+    return _write(envelopes, out_dir, title, features)
