@@ -404,6 +404,11 @@ def gauge_figure(rows, start: datetime | None = None):
         t = np.array([r[0] for r in mine]) / scale
         depth_ax.plot(t, [r[2] for r in mine], label=gid)
         level_ax.plot(t, [r[3] for r in mine], label=gid)
+    if top > 0:
+        level_ax.set_xlim(0.0, top / scale)
+    if not any(math.isfinite(r[2]) for r in rows):
+        depth_ax.text(0.5, 0.5, "every gauge stayed dry", transform=depth_ax.transAxes,
+                      ha="center", va="center")
     depth_ax.set_ylabel("depth [m]")
     level_ax.set_ylabel("water level [m]")
     depth_ax.set_title("gauges: depth and water level (gaps: dry)")

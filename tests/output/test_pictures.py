@@ -155,3 +155,18 @@ def test_walls_sinks_gauges_and_the_caption_are_drawn(envelopes):
         assert any(len(xy) == 4 and np.allclose(xy[:3], sink / 1e3) for xy in lines), name
         assert "G7" in [t.get_text() for t in ax.texts], name
         assert fig.get_supxlabel() == caption
+
+
+def test_gauge_plot_spans_the_run_and_says_when_every_gauge_stayed_dry():
+    from floodsph.output.pictures import gauge_figure
+
+    nan = float("nan")
+    rows = [(t, "G1", nan, nan, nan) for t in (0.0, 30.0, 60.0)]
+    depth_ax, level_ax = gauge_figure(rows).axes[:2]
+    assert level_ax.get_xlim() == (0.0, 60.0)
+    assert [t.get_text() for t in depth_ax.texts] == ["every gauge stayed dry"]
+    wet = [(0.0, "G1", nan, nan, nan), (30.0, "G1", 0.4, 100.4, 1.0), (60.0, "G1", 0.9, 100.9,
+                                                                           1.2)]
+    depth_ax, _ = gauge_figure(wet).axes[:2]
+    assert not depth_ax.texts
+    assert np.allclose(depth_ax.get_lines()[0].get_xydata()[1:], [[30.0, 0.4], [60.0, 0.9]])
