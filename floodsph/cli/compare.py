@@ -15,18 +15,21 @@ _FILE = click.Path(exists=True, dir_okay=False, path_type=Path)
 @click.option("--points", type=_FILE, default=None,
               help="CSV of observations (id,x,y,observed) in the map CRS.")
 @click.option("--arrival", is_flag=True,
-              help="Treat the maps as arrival times (detected from the band description or "
-                   "NetCDF variable otherwise).")
+              help="Take maps that do not say what they hold as arrival times (read from "
+                   "the standard name, band description, NetCDF variable or units otherwise).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="Folder for difference.tif, comparison.json and comparison.png.")
+              help="Folder for difference.tif, comparison.json, points.csv (with --points) "
+                   "and comparison.png.")
 def command(model, reference, threshold, points, arrival, out):
     """Compare MODEL with REFERENCE (a benchmark or another scenario).
 
     Each map is a single-band raster file (GeoTIFF, ASCII grid, ...) or a NetCDF variable
-    named FILE.nc:VARIABLE, e.g. out/valley/flood_maps.nc:max_depth. REFERENCE is
+    named FILE.nc:VARIABLE, e.g. out/valley/flood_maps.nc:max_depth. Both must hold the same
+    quantity (depth, speed, arrival time, ...: read from their metadata). REFERENCE is
     reprojected onto MODEL's grid (bilinear; nearest for class maps). Prints the contingency
-    counts, hit rate, false alarm ratio, CSI, F2, error bias and the depth (or arrival-time)
-    RMSE and bias over cells wet in both.
+    counts, hit rate, false alarm ratio, CSI, F2, error bias and the RMSE and bias of the
+    values over cells wet in both. Observation points off the model map are reported as
+    outside and left out of the statistics.
     """
     from floodsph.output.compare import compare, format_table, write_outputs
 

@@ -11,12 +11,14 @@ from pathlib import Path
 FORMATS = ("geotiff", "netcdf")
 
 
-def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None) -> list[Path]:
+def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None,
+               start=None) -> list[Path]:
     """Write every envelope map of the run-folder contract.
 
     ``geotiff``: ``<name>.tif`` for each map of :data:`floodsph.output.envelopes.MAPS`;
     ``netcdf``: all of them in ``flood_maps.nc``. The wet threshold and hazard land use are
-    taken from ``envelopes`` and recorded in the files with the resolved ``scenario``.
+    taken from ``envelopes`` and recorded in the files with the resolved ``scenario``; the
+    NetCDF ``time`` counts from ``start`` (a time zone aware datetime, or None).
 
     Returns the written paths.
     """
@@ -38,6 +40,8 @@ def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None
     colours = {"hazard_uk": UK_COLOURS, "hazard_arr": ARR_COLOURS}
     tags = {"wet_threshold_m": envelopes.wet_threshold, "hazard_land_use": tables.land_use,
             "source": f"floodsph {__version__}"}
+    if envelopes.t_last is not None:
+        tags["period_s"] = repr(float(envelopes.t_last))
     written = []
     if "geotiff" in formats:
         from floodsph.output.geotiff import write_geotiff
@@ -53,16 +57,17 @@ def write_maps(envelopes, out_dir, formats=FORMATS, scenario: dict | None = None
         written.append(write_flood_maps(out_dir / "flood_maps.nc", maps, MAPS, grid,
                                         class_names=class_names, scenario=scenario,
                                         wet_threshold=envelopes.wet_threshold,
-                                        period_s=envelopes.t_last))
+                                        period_s=envelopes.t_last, start=start))
     return written
 
 
-def write_pictures(envelopes, out_dir, title: str = "") -> list[Path] | str:
-    """Quick-look PNGs of the envelopes (see :mod:`floodsph.output.pictures`).
+def write_pictures(envelopes, out_dir, title: str = "", features=None) -> list[Path] | str:
+    """Quick-look PNGs of the envelopes, with the walls, sinks, gauges and caption of
+    ``features`` (see :mod:`floodsph.output.pictures`).
 
     Returns the written paths, or the message ``"pictures skipped: matplotlib not
     installed"``.
     """
     from floodsph.output.pictures import write_pictures as _write
 
-    return _write(envelopes, out_dir, title)
+    return _write(envelopes, out_dir, title, features)

@@ -16,9 +16,10 @@ version 93 and later):
   ... with one ``flag_meanings`` word per value (0 = dry);
 * the maxima, the duration and the hazard classes (``cell_methods = "time: ..."``) refer to
   a scalar ``time`` coordinate whose bounds are the period they cover (0 to the last update);
-* ``time`` is ``seconds since`` :data:`TIME_REFERENCE`: the scenario has no calendar start,
-  so the start of the run is placed at that fixed date (the ``comment`` of ``time`` says so).
-  Arrival time, time of the maximum and duration are durations in ``s`` from the same start.
+* ``time`` is ``seconds since`` the scenario's ``[scenario] start`` in UTC
+  (:func:`time_attrs`); a scenario without one has its start placed at the fixed date
+  :data:`NO_START`, and the ``comment`` of ``time`` says that date means nothing. Arrival
+  time, time of the maximum and duration are durations in ``s`` from the same start.
 """
 
 from __future__ import annotations
@@ -35,19 +36,31 @@ CONVENTIONS = "CF-1.8"
 REFERENCES = ("Vacondio, Rogers, Stansby, Mignosa & Feldman (2013), Adv. Water Resour. 58, "
               "10-23; hazard: Defra/EA FD2320-FD2321; AIDR Guideline 7-3 (2017)")
 
-TIME_REFERENCE = "1970-01-01 00:00:00"
-"""The date given to the start of the run (t = 0) in ``time`` units; it has no meaning."""
-TIME_ATTRS = {
-    "standard_name": "time",
-    "long_name": "simulated time",
-    "units": f"seconds since {TIME_REFERENCE}",
-    "calendar": "standard",
-    "axis": "T",
-    "comment": (f"time since the start of the run; the scenario has no calendar start time, "
-                f"so the start of the run is placed at the fixed reference {TIME_REFERENCE} "
-                f"UTC, which carries no meaning: read the values as seconds of simulated "
-                f"time"),
-}
+NO_START = datetime(1970, 1, 1, tzinfo=UTC)
+"""The instant given to t = 0 when the scenario has no ``[scenario] start``: a placeholder
+with no meaning (the times are then seconds of simulated time)."""
+
+
+def time_units(start: datetime | None) -> str:
+    """CF ``units`` of the ``time`` coordinate: ``seconds since <start in UTC>``."""
+    instant = (start or NO_START).astimezone(UTC)
+    return f"seconds since {instant.strftime('%Y-%m-%d %H:%M:%S')}"
+
+
+def time_attrs(start: datetime | None) -> dict:
+    """Attributes of the ``time`` coordinate: seconds since the scenario's start (UTC), or
+    since :data:`NO_START` with a comment saying it has no meaning."""
+    if start is None:
+        comment = ("time since the start of the run; the scenario gives no calendar start "
+                   "([scenario] start), so the start of the run is placed at the fixed "
+                   "reference 1970-01-01 00:00:00 UTC, which carries no meaning: read the "
+                   "values as seconds of simulated time")
+    else:
+        comment = (f"time since the start of the run, {start.isoformat()} "
+                   f"([scenario] start), in UTC")
+    return {"standard_name": "time", "long_name": "simulated time", "units": time_units(start),
+            "calendar": "standard", "axis": "T", "comment": comment}
+
 
 STANDARD_NAMES = {
     "max_depth": "flood_water_thickness",
@@ -120,9 +133,9 @@ def flag_meanings(names) -> str:
 
 
 def flag_attrs(names) -> dict:
-    """``flag_values`` 0..n-1 (:data:`CLASS_DTYPE`) and ``flag_meanings`` of the class names
-    (index = value)."""
-    return {"flag_values": np.arange(len(names), dtype=CLASS_DTYPE),
+    """``flag_values`` 0..n-1 (uint8, as the class maps in memory; the NetCDF writers store
+    both as :data:`CLASS_DTYPE`) and ``flag_meanings`` of the class names (index = value)."""
+    return {"flag_values": np.arange(len(names), dtype=np.uint8),
             "flag_meanings": flag_meanings(names)}
 
 

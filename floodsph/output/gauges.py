@@ -12,6 +12,7 @@ import csv
 import io
 import math
 from dataclasses import dataclass
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,8 @@ from floodsph.io.text import read_text
 from floodsph.output.grid import bilinear
 
 HEADER = ("time_s", "id", "depth_m", "level_m", "speed_ms")
+CALENDAR_COLUMN = "time_utc"
+"""The column added when the scenario has a calendar start: start + time_s, ISO 8601 in UTC."""
 
 
 @dataclass(frozen=True)
@@ -82,11 +85,15 @@ class Gauges:
         Depth [m] at or below which a gauge reports NaN.
     min_support : float
         Minimum kernel sum (see :mod:`floodsph.output.rasterise`).
+    start : datetime, optional
+        The calendar instant of t = 0 (``[scenario] start``); adds :data:`CALENDAR_COLUMN`.
     """
 
     def __init__(self, points: GaugePoints, interval_s: float = 10.0,
-                 wet_threshold: float = 0.01, min_support: float = 0.5):
+                 wet_threshold: float = 0.01, min_support: float = 0.5,
+                 start: datetime | None = None):
         self.points = points
+        self.start = start
         self.interval_s = float(interval_s)
         self.wet_threshold = float(wet_threshold)
         self.min_support = float(min_support)
@@ -114,11 +121,20 @@ class Gauges:
         self.sample(model.t, q.x, q.y, q.u, q.v, q.m, q.rho, q.h)
 
     def write_csv(self, path) -> Path:
-        """Write ``time_s, id, depth_m, level_m, speed_ms`` (mm / ms precision; ``nan`` = dry)."""
+        """Write ``time_s, id, depth_m, level_m, speed_ms`` (mm / ms precision; ``nan`` = dry),
+        and ``time_utc`` (``2024-01-15T06:10:00.000Z``) when the scenario has a start."""
         path = Path(path)
         with open(path, "w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(HEADER)
+            w.writerow(HEADER + ((CALENDAR_COLUMN,) if self.start is not None else ()))
             for t, gid, d, lvl, s in self.rows:
-                w.writerow((f"{t:.3f}", gid, f"{d:.4f}", f"{lvl:.4f}", f"{s:.4f}"))
+                row = (f"{t:.3f}", gid, f"{d:.4f}", f"{lvl:.4f}", f"{s:.4f}")
+                if self.start is not None:
+                    row += (utc_text(self.start + timedelta(seconds=round(t, 3))),)
+                w.writerow(row)
         return path
+
+
+def utc_text(instant: datetime) -> str:
+    """An instant as ISO 8601 in UTC to the millisecond: ``2024-01-15T06:10:00.000Z``."""
+    return instant.astimezone(UTC).strftime("%Y-%m-%dT%H:%M:%S.%f")[:-3] + "Z"

@@ -22,21 +22,19 @@ import numpy as np
 BLOCK = 512
 
 
-def _profile(grid, dtype, nodata, predictor) -> dict:
-    from rasterio.crs import CRS
-
-    block = BLOCK if min(grid.nx, grid.ny) >= BLOCK else 256
+def _profile(shape, crs, transform, dtype, nodata, predictor) -> dict:
+    ny, nx = shape
     return {
-        "width": grid.nx,
-        "height": grid.ny,
+        "width": nx,
+        "height": ny,
         "count": 1,
         "dtype": dtype,
         "nodata": nodata,
-        "crs": CRS.from_wkt(grid.crs_wkt) if grid.crs_wkt else None,
-        "transform": grid.north_up_transform(),
+        "crs": crs,
+        "transform": transform,
         "compress": "deflate",
         "predictor": predictor,
-        "blocksize": block,
+        "blocksize": BLOCK if min(nx, ny) >= BLOCK else 256,
     }
 
 
@@ -67,17 +65,30 @@ def write_geotiff(path, array, grid, name: str, units: str, *, long_name: str = 
     -------
     Path of the written file.
     """
+    from rasterio.crs import CRS
+
+    crs = CRS.from_wkt(grid.crs_wkt) if grid.crs_wkt else None
+    return write_north_up(path, np.asarray(array)[::-1], crs, grid.north_up_transform(), name,
+                          units, long_name=long_name, class_names=class_names,
+                          colours=colours, tags=tags, driver=driver)
+
+
+def write_north_up(path, array, crs, transform, name: str, units: str, *, long_name: str = "",
+                   class_names=None, colours=None, tags: dict | None = None,
+                   driver: str | None = None) -> Path:
+    """Write one north-up map (row 0 = north) with its CRS and affine ``transform`` as a
+    GeoTIFF in the COG layout; the other arguments are those of :func:`write_geotiff`."""
     import rasterio
     from rasterio.enums import ColorInterp
 
     path = Path(path)
     is_class = np.asarray(array).dtype == np.uint8
     if is_class:
-        data = np.ascontiguousarray(np.asarray(array, dtype=np.uint8)[::-1])
-        profile = _profile(grid, "uint8", 0, 2)
+        data = np.ascontiguousarray(array, dtype=np.uint8)
+        profile = _profile(data.shape, crs, transform, "uint8", 0, 2)
     else:
-        data = np.ascontiguousarray(np.asarray(array, dtype=np.float32)[::-1])
-        profile = _profile(grid, "float32", float("nan"), 3)
+        data = np.ascontiguousarray(array, dtype=np.float32)
+        profile = _profile(data.shape, crs, transform, "float32", float("nan"), 3)
     band_tags = {"units": units, "long_name": long_name or name}
     if class_names is not None:
         band_tags.update({f"class_{k}": str(n) for k, n in enumerate(class_names)})

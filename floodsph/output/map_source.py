@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from floodsph.errors import InputError
+from floodsph.output.quantities import MapMetadata, Quantity, identify
 
 NETCDF_MAGIC = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
 """First bytes of classic, 64-bit offset, CDF5 and netCDF-4 (HDF5) files."""
@@ -30,13 +31,29 @@ GDAL_PREFIXES = ("/vsi", "NETCDF:", "HDF5:", "GTIFF_DIR:")
 
 @dataclass
 class Raster:
-    """One band of a map file: data as float64 (NaN = nodata), georeference and kind."""
+    """One band of a map file: data as float64 (NaN = nodata), georeference and quantity.
+
+    ``quantity`` is None for a float map whose metadata say nothing
+    (:func:`floodsph.output.quantities.identify`); ``evidence`` says what decided it.
+    """
 
     path: str
     data: np.ndarray
     transform: object
     crs: object
-    kind: str  # "depth", "arrival" or "class"
+    quantity: Quantity | None
+    evidence: str = ""
+
+    @property
+    def kind(self) -> str | None:
+        """The quantity's name (``depth``, ``arrival``, ``hazard_uk``...), None if unknown."""
+        return None if self.quantity is None else self.quantity.name
+
+    def described(self) -> str:
+        """``max_depth.tif is a depth map (band description 'max_depth')``."""
+        if self.quantity is None:
+            return f"{self.path} is a map of unknown quantity"
+        return f"{self.path} is {self.quantity.label} map ({self.evidence})"
 
 
 def is_netcdf(path: Path) -> bool:
@@ -70,13 +87,13 @@ def netcdf_maps(path: str) -> list[str]:
             return [s.rsplit(":", 1)[-1] for s in src.subdatasets]
 
 
-def read_raster(name, arrival: bool = False) -> Raster:
+def read_raster(name) -> Raster:
     """Read the single band of a map (see the module docstring); InputError if it cannot be
     read, holds several bands or variables, or has no CRS.
 
-    Integer maps are class maps (nodata, or 0 without one, is class 0 = dry); float maps are
-    arrival times when ``arrival`` is set or the band description, NetCDF variable or
-    standard name says so, else depths.
+    Its quantity comes from its metadata (:func:`floodsph.output.quantities.identify`).
+    Class maps (integer data) read nodata, or 0 without one, as class 0 = dry; float maps
+    read nodata as NaN.
     """
     import rasterio
 
@@ -100,18 +117,19 @@ def read_raster(name, arrival: bool = False) -> Raster:
         nodata, dtype = src.nodata, src.dtypes[0]
         transform, crs = src.transform, src.crs
         tags = src.tags(1)
-        words = " ".join([src.descriptions[0] or "", variable or "", tags.get("long_name", ""),
-                          tags.get("standard_name", "")]).lower()
+        integer = bool(np.issubdtype(np.dtype(dtype), np.integer))
+        meta = MapMetadata(description=src.descriptions[0] or "", variable=variable or "",
+                           long_name=tags.get("long_name", ""),
+                           standard_name=tags.get("standard_name", ""),
+                           units=src.units[0] or tags.get("units", ""), integer=integer)
     if crs is None:
         raise InputError(f"{name}: the raster has no CRS; cannot align it with the other map")
-    if np.issubdtype(np.dtype(dtype), np.integer):
-        kind = "class"
+    if integer:
         data[data == (nodata if nodata is not None else 0)] = 0.0
-    else:
-        kind = "arrival" if arrival or "arrival" in words or "rises_above" in words else "depth"
-        if nodata is not None and not math.isnan(nodata):
-            data[data == nodata] = np.nan
-    return Raster(name, data, transform, crs, kind)
+    elif nodata is not None and not math.isnan(nodata):
+        data[data == nodata] = np.nan
+    quantity, evidence = identify(meta)
+    return Raster(name, data, transform, crs, quantity, evidence)
 
 
 def _unreadable(name: str, variable: str | None, error) -> str:

@@ -16,6 +16,7 @@ Global attributes: ``Conventions``, ``title``, ``source = "floodsph <version>"``
 from __future__ import annotations
 
 import os
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -25,28 +26,64 @@ from floodsph.output.cf import (
     COORD_ATTRS,
     THRESHOLD,
     THRESHOLD_ATTRS,
-    TIME_ATTRS,
     USES_THRESHOLD,
     flag_attrs,
     global_attrs,
     grid_coords,
     grid_mapping_attrs,
     no_fill,
+    time_attrs,
     variable_attrs,
 )
 
 
 def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
                      scenario: dict | None = None, wet_threshold: float = 0.01,
-                     period_s: float | None = None, title: str = "floodsph flood maps") -> Path:
-    """Write the envelope maps as one CF-1.8 NetCDF file.
+                     period_s: float | None = None, title: str = "floodsph flood maps",
+                     start: datetime | None = None) -> Path:
+    """Write the envelope maps as one CF-1.8 NetCDF file: :func:`flood_maps_dataset` with
+    float maps as float32, zlib level 4, ``_FillValue = NaN``, and class maps as CF ``byte``.
 
     Parameters
     ----------
     path : path-like
         Output file (``flood_maps.nc``).
+    maps, info, grid, class_names, scenario, wet_threshold, period_s, title, start
+        As :func:`flood_maps_dataset`.
+    """
+    path = Path(path)
+    ds = flood_maps_dataset(maps, info, grid, class_names=class_names, scenario=scenario,
+                            wet_threshold=wet_threshold, period_s=period_s, title=title,
+                            start=start)
+    chunks = (min(grid.ny, 256), min(grid.nx, 256))
+    encoding = no_fill([*ds.coords, *(n for n in ("time_bounds",) if n in ds)])
+    if "crs" in ds:
+        encoding["crs"] = {"dtype": "int32"}
+    for name in maps:
+        if "flag_values" in ds[name].attrs:
+            encoding[name] = {"_FillValue": None, "dtype": CLASS_DTYPE}
+            ds[name].attrs["flag_values"] = ds[name].attrs["flag_values"].astype(CLASS_DTYPE)
+        else:
+            encoding[name] = {"_FillValue": np.float32(np.nan)}
+        encoding[name].update(zlib=True, complevel=4, chunksizes=chunks)
+    part = path.with_name(path.name + ".part")
+    ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
+    os.replace(part, path)
+    return path
+
+
+def flood_maps_dataset(maps: dict, info: dict, grid, *, class_names: dict,
+                       scenario: dict | None = None, wet_threshold: float = 0.01,
+                       period_s: float | None = None, title: str = "floodsph flood maps",
+                       start: datetime | None = None):
+    """The envelope maps as an ``xarray.Dataset`` laid out and described as ``flood_maps.nc``
+    (CF-1.8, :mod:`floodsph.output.cf`), before encoding: ``time`` in seconds.
+
+    Parameters
+    ----------
     maps : dict name -> (ny, nx) array
-        South-up maps (row 0 = south); uint8 arrays are class maps (written as CF ``byte``).
+        South-up maps (row 0 = south); uint8 arrays are class maps (flag variables, uint8;
+        :func:`write_flood_maps` stores them as CF ``byte``).
     info : dict name -> (long_name, units, cell_methods or None)
         Metadata per map (:data:`floodsph.output.envelopes.MAPS`).
     grid : OutputGrid
@@ -60,35 +97,30 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
         with bounds [0, period_s], the interval of the maps' ``cell_methods``.
     scenario, title
         Recorded in the global attributes.
+    start : datetime, optional
+        The calendar instant of t = 0 (``[scenario] start``): ``time`` is seconds since it.
     """
     import xarray as xr
 
-    path = Path(path)
-    chunks = (min(grid.ny, 256), min(grid.nx, 256))
     crs = grid_mapping_attrs(grid)
     coords = grid_coords(grid)
     coords[THRESHOLD] = xr.Variable((), np.float64(wet_threshold), THRESHOLD_ATTRS)
     data_vars = {}
     if period_s is not None:
         coords["time"] = xr.Variable((), np.float64(period_s),
-                                     dict(TIME_ATTRS, bounds="time_bounds"))
+                                     dict(time_attrs(start), bounds="time_bounds"))
         data_vars["time_bounds"] = xr.Variable("nv", np.array([0.0, period_s]))
-    encoding = no_fill([*coords, *data_vars])
     if crs is not None:
         data_vars["crs"] = xr.Variable((), np.int32(0), crs)
-        encoding["crs"] = {"dtype": "int32"}
     for name, arr in maps.items():
         long_name, units, cell_methods = info[name]
         attrs = variable_attrs(name, long_name, units, cell_methods=cell_methods,
                                grid_mapping=crs is not None)
         if np.asarray(arr).dtype == np.uint8:
             attrs.update(flag_attrs(class_names[name]))
-            data = np.asarray(arr, dtype=CLASS_DTYPE)[::-1]
-            encoding[name] = {"_FillValue": None}
+            data = np.asarray(arr, dtype=np.uint8)[::-1]
         else:
             data = np.asarray(arr, dtype=np.float32)[::-1]
-            encoding[name] = {"_FillValue": np.float32(np.nan)}
-        encoding[name].update(zlib=True, complevel=4, chunksizes=chunks)
         data_vars[name] = xr.Variable(("y", "x"), data, attrs)
         names = [THRESHOLD] if name in USES_THRESHOLD else []
         if cell_methods and period_s is not None:
@@ -97,11 +129,7 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
     for name in ("crs", "time_bounds"):
         if name in data_vars:
             data_vars[name].encoding["coordinates"] = None
-    ds = xr.Dataset(data_vars, coords=coords, attrs=global_attrs(title, scenario, wet_threshold))
-    part = path.with_name(path.name + ".part")
-    ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
-    os.replace(part, path)
-    return path
+    return xr.Dataset(data_vars, coords=coords, attrs=global_attrs(title, scenario, wet_threshold))
 
 
 SNAPSHOT_VARIABLES = {
@@ -117,8 +145,8 @@ SNAPSHOT_VARIABLES = {
 class SnapshotWriter:
     """Append depth and velocity maps at successive times to ``snapshots.nc`` (CF-1.8).
 
-    The file has an unlimited ``time`` dimension (seconds since the start of the run, placed
-    at :data:`floodsph.output.cf.TIME_REFERENCE`) and the variables of
+    The file has an unlimited ``time`` dimension (seconds since the start of the run,
+    ``start``: :func:`floodsph.output.cf.time_attrs`) and the variables of
     :data:`SNAPSHOT_VARIABLES` on (time, y, x), NaN where unsupported. Use as a context
     manager or call :meth:`close`. ``keep_frames`` > 0 continues the frames of an earlier
     file, ``source`` (default ``path`` itself; a resumed run): its first ``keep_frames``
@@ -127,7 +155,8 @@ class SnapshotWriter:
     """
 
     def __init__(self, path, grid, *, scenario: dict | None = None,
-                 wet_threshold: float = 0.01, keep_frames: int = 0, source=None):
+                 wet_threshold: float = 0.01, keep_frames: int = 0, source=None,
+                 start: datetime | None = None):
         import netCDF4
 
         self.path = Path(path)
@@ -147,7 +176,7 @@ class SnapshotWriter:
             var.setncatts(COORD_ATTRS[name])
             var[:] = values
         t = ds.createVariable("time", "f8", ("time",), fill_value=False)
-        t.setncatts(TIME_ATTRS)
+        t.setncatts(time_attrs(start))
         crs = grid_mapping_attrs(grid)
         if crs is not None:
             ds.createVariable("crs", "i4", ()).setncatts(crs)

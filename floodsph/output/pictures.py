@@ -1,23 +1,64 @@
-"""Quick-look PNGs of a run's maps (depth, speed, d·v, duration, hazard, arrival) and of an
-ensemble's probability map.
+"""Quick-look PNGs of a run's maps (depth, speed, d·v, duration, hazard, arrival), of its
+gauges and mass balance over time, and of an ensemble's probability map.
 
 matplotlib is optional (``floodsph[plot]``): without it every function returns the message
 ``"pictures skipped: matplotlib not installed"`` instead of paths. Figures are drawn with
 ``matplotlib.figure.Figure`` (no pyplot state, no GUI backend), north up, axes in km of the
 map CRS, over a hillshade of the bed, with a title, a colour bar or legend with units, a
-north arrow and a scale bar. The figure builders (``*_figure``) return the Figure, so that
-its layout can be checked without writing a file.
+north arrow and a scale bar. The maximum depth is drawn in the depth bands of
+:mod:`floodsph.output.areas` (a continuous ramp from 0 to the deepest cell leaves metre-deep
+floodplains almost white beside a 30 m deep gorge). :class:`MapFeatures` adds the walls,
+sinks and gauges and a caption with the CRS and the period the maps cover. The figure
+builders (``*_figure``) return the Figure, so that its layout can be checked without
+writing a file.
 """
 
 from __future__ import annotations
 
 import math
 import textwrap
+from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
 
 SKIPPED = "pictures skipped: matplotlib not installed"
+SERIES_PICTURES = ("gauges.png", "mass_balance.png")
+"""The time-series pictures of :func:`write_series_pictures`."""
+
+
+@dataclass(frozen=True)
+class MapFeatures:
+    """What is drawn over every map, in world coordinates [m] of the map CRS: walls
+    (polylines, black on a white halo), sinks (polygons, dashed purple outline), gauges
+    (id, x, y: red triangles with their ids); and a caption under the map
+    (:func:`map_caption`)."""
+
+    walls: tuple = ()
+    sinks: tuple = ()
+    gauges: tuple = ()
+    caption: str = ""
+
+
+def map_caption(crs_wkt: str | None, period_s: float | None, start: datetime | None) -> str:
+    """``CRS: WGS 84 / UTM zone 32N (EPSG:32632); maxima over t = 0 to 600 s from 2024-01-15
+    06:00 UTC``: what every map of a run states about where and when it is."""
+    from floodsph.output.gauges import utc_text
+
+    if crs_wkt:
+        import pyproj
+
+        crs = pyproj.CRS.from_wkt(crs_wkt)
+        code = crs.to_epsg()
+        where = f"CRS: {crs.name}" + (f" (EPSG:{code})" if code else "")
+    else:
+        where = "no CRS (local coordinates)"
+    if period_s is None:
+        return where
+    when = (f"from {utc_text(start)[:16].replace('T', ' ')} UTC" if start is not None
+            else "(no calendar start)")
+    return f"{where}; maxima over t = 0 to {period_s:g} s {when}"
 
 CONTINUOUS = {
     "max_depth": ("maximum depth", "Blues", "m"),
@@ -43,8 +84,9 @@ def have_matplotlib() -> bool:
     return True
 
 
-def _axes(grid, title):
-    """Figure and axes sized to the map aspect, axes in km, north arrow and scale bar."""
+def _axes(grid, title, features: MapFeatures | None = None):
+    """Figure and axes sized to the map aspect, axes in km, north arrow and scale bar; the
+    caption of ``features`` under the map."""
     from matplotlib.figure import Figure
 
     aspect = (grid.ny * grid.dy) / (grid.nx * grid.dx)
@@ -57,7 +99,30 @@ def _axes(grid, title):
                 ha="center", va="center", fontsize=12, fontweight="bold",
                 arrowprops={"arrowstyle": "-|>", "color": "k"})
     _scale_bar(ax, grid.nx * grid.dx)
+    if features is not None and features.caption:
+        fig.supxlabel(textwrap.fill(features.caption, 110), fontsize=8)
     return fig, ax
+
+
+def _draw_features(ax, features: MapFeatures | None) -> None:
+    """Walls, sinks and gauges over the map (axes in km), above every layer."""
+    from matplotlib import patheffects
+
+    if features is None:
+        return
+    halo = [patheffects.withStroke(linewidth=3.5, foreground="white")]
+    for line in features.walls:
+        xy = np.asarray(line) / 1e3
+        ax.plot(xy[:, 0], xy[:, 1], color="k", linewidth=1.6, zorder=5, path_effects=halo)
+    for polygon in features.sinks:
+        xy = np.asarray(polygon) / 1e3
+        xy = np.vstack([xy, xy[:1]])
+        ax.plot(xy[:, 0], xy[:, 1], color="#7b3294", linewidth=1.2, linestyle="--", zorder=5)
+    for gid, x, y in features.gauges:
+        ax.plot(x / 1e3, y / 1e3, marker="^", color="#d7191c", markeredgecolor="k",
+                markersize=7, linestyle="none", zorder=6)
+        ax.annotate(gid, (x / 1e3, y / 1e3), xytext=(4, 4), textcoords="offset points",
+                    fontsize=7, zorder=6)
 
 
 def _frame(ax, title):
@@ -115,41 +180,74 @@ def time_unit(top_s: float) -> tuple[float, str]:
     return 3600.0, "h"
 
 
-def write_pictures(envelopes, out_dir, title: str = "") -> list[Path] | str:
-    """Write one PNG per map of :data:`PICTURES` (``<name>.png``) into ``out_dir``."""
+def write_pictures(envelopes, out_dir, title: str = "",
+                   features: MapFeatures | None = None) -> list[Path] | str:
+    """Write one PNG per map of :data:`PICTURES` (``<name>.png``) into ``out_dir``, with the
+    walls, sinks, gauges and caption of ``features``."""
     if not have_matplotlib():
         return SKIPPED
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
     for name in PICTURES:
-        written.append(_save(map_figure(envelopes, name, title), out_dir / f"{name}.png"))
+        fig = map_figure(envelopes, name, title, features)
+        written.append(_save(fig, out_dir / f"{name}.png"))
     return written
 
 
-def map_figure(envelopes, name: str, title: str = ""):
+def map_figure(envelopes, name: str, title: str = "", features: MapFeatures | None = None):
     """The Figure of the map ``name`` (one of :data:`PICTURES`) of the envelopes."""
     grid = envelopes.grid
     maps = envelopes.maps()
     prefix = f"{title}: " if title else ""
     if name in CLASSES:
-        return _class_figure(grid, maps[name], envelopes.tables, name, prefix)
-    if name == "arrival_time":
-        return _arrival_figure(grid, maps[name], prefix)
+        fig = _class_figure(grid, maps[name], envelopes.tables, name, prefix, features)
+    elif name == "arrival_time":
+        fig = _arrival_figure(grid, maps[name], prefix, features)
+    elif name == "max_depth":
+        fig = _depth_figure(grid, maps[name], envelopes.wet_threshold, prefix, features)
+    else:
+        fig = _continuous_figure(grid, maps, name, envelopes.wet_threshold, prefix, features)
+    _draw_features(fig.axes[0], features)
+    return fig
+
+
+def _depth_figure(grid, max_depth, wet_threshold, prefix, features):
+    """The maximum depth in the bands of :func:`floodsph.output.areas.depth_bands`, one
+    colour each, the colour bar's bands of equal size whatever their depth range."""
+    from matplotlib import colors
+
+    from floodsph.output.areas import depth_bands
+
+    bands = depth_bands(wet_threshold)
+    top = bands[-1].lower * 2.0
+    edges = [b.lower for b in bands] + [max(top, float(np.nanmax(max_depth, initial=0.0)))]
+    cmap = colors.ListedColormap([b.colour for b in bands])
+    fig, ax = _axes(grid, f"{prefix}{CONTINUOUS['max_depth'][0]}", features)
+    wet = np.where(np.nan_to_num(max_depth) > wet_threshold, max_depth, np.nan)
+    im = ax.imshow(np.ma.masked_invalid(wet), cmap=cmap, norm=colors.BoundaryNorm(edges, cmap.N),
+                   origin="lower", extent=_extent(grid), alpha=0.9, interpolation="nearest")
+    bar = fig.colorbar(im, ax=ax, label="maximum depth [m]", shrink=0.8, spacing="uniform",
+                       ticks=edges[:-1])
+    bar.ax.set_yticklabels([f"{e:g}" for e in edges[:-1]])
+    return fig
+
+
+def _continuous_figure(grid, maps, name, wet_threshold, prefix, features):
     label, cmap, units = CONTINUOUS[name]
-    wet = np.nan_to_num(maps["max_depth"]) > envelopes.wet_threshold
+    wet = np.nan_to_num(maps["max_depth"]) > wet_threshold
     values = np.where(wet, maps[name], np.nan)
     scale = 1.0
     if units is None:
         scale, units = time_unit(float(np.nanmax(values)) if wet.any() else 0.0)
-    fig, ax = _axes(grid, f"{prefix}{label}")
+    fig, ax = _axes(grid, f"{prefix}{label}", features)
     im = ax.imshow(np.ma.masked_invalid(values / scale), cmap=cmap, origin="lower",
                    extent=_extent(grid), alpha=0.85, interpolation="nearest", vmin=0.0)
     fig.colorbar(im, ax=ax, label=f"{label} [{units}]", shrink=0.8)
     return fig
 
 
-def _class_figure(grid, classes, tables, name, prefix):
+def _class_figure(grid, classes, tables, name, prefix, features=None):
     """Class map with a legend of every class (wrapped names) beside the map."""
     from matplotlib import colors
     from matplotlib.patches import Patch
@@ -159,7 +257,7 @@ def _class_figure(grid, classes, tables, name, prefix):
     names = tables.uk_names if name == "hazard_uk" else tables.arr_names
     rgb = [np.array(c) / 255.0 for c in (UK_COLOURS if name == "hazard_uk" else ARR_COLOURS)]
     k = len(names)
-    fig, ax = _axes(grid, f"{prefix}{CLASSES[name]} (maximum)")
+    fig, ax = _axes(grid, f"{prefix}{CLASSES[name]} (maximum)", features)
     cmap = colors.ListedColormap(rgb[1:k])
     ax.imshow(np.ma.masked_equal(classes, 0), cmap=cmap,
               norm=colors.BoundaryNorm(np.arange(0.5, k), cmap.N), origin="lower",
@@ -172,8 +270,8 @@ def _class_figure(grid, classes, tables, name, prefix):
     return fig
 
 
-def _arrival_figure(grid, arrival_s, prefix):
-    fig, ax = _axes(grid, f"{prefix}arrival time")
+def _arrival_figure(grid, arrival_s, prefix, features=None):
+    fig, ax = _axes(grid, f"{prefix}arrival time", features)
     if not np.isfinite(arrival_s).any():
         return fig
     top = float(np.nanmax(arrival_s))
@@ -246,12 +344,13 @@ def comparison_figure(result):
     s = result.summary
     diff = result.difference
     lim = float(np.nanmax(np.abs(diff))) if np.isfinite(diff).any() else 1.0
-    units = "s" if s["kind"] == "arrival" else ("class" if s["kind"] == "class" else "m")
+    quantity = result.model.quantity
+    units = "class" if quantity.classes else quantity.units
     im = ax2.imshow(diff, cmap="RdBu_r", vmin=-lim, vmax=lim, extent=extent,
                     interpolation="nearest")
     fig.colorbar(im, ax=ax2, label=f"model - reference [{units}]", shrink=0.8)
     _frame(ax1, f"wet/dry agreement: CSI = {s['csi']:.3f}, H = {s['hit_rate']:.3f}")
-    _frame(ax2, f"{s['kind']} difference")
+    _frame(ax2, f"{quantity.name} difference")
     for ax in (ax1, ax2):
         _scale_bar(ax, nx * abs(t.a))
     return fig
@@ -262,3 +361,82 @@ def plot_comparison(result, path) -> Path | str:
     if not have_matplotlib():
         return SKIPPED
     return _save(comparison_figure(result), path)
+
+
+def write_series_pictures(gauge_rows, mass_rows, out_dir,
+                          start: datetime | None = None) -> list[Path] | str:
+    """``gauges.png`` (:func:`gauge_figure`, when there are gauge rows) and
+    ``mass_balance.png`` (:func:`mass_balance_figure`) into ``out_dir``; or the ``SKIPPED``
+    message."""
+    if not have_matplotlib():
+        return SKIPPED
+    out_dir = Path(out_dir)
+    written = []
+    if gauge_rows:
+        written.append(_save(gauge_figure(gauge_rows, start), out_dir / SERIES_PICTURES[0]))
+    if mass_rows:
+        written.append(_save(mass_balance_figure(mass_rows), out_dir / SERIES_PICTURES[1]))
+    return written
+
+
+def _time_axis(ax, top_s: float, start: datetime | None) -> float:
+    """Label the x axis with the time unit for times up to ``top_s``; its seconds per unit."""
+    from floodsph.output.gauges import utc_text
+
+    scale, unit = time_unit(top_s)
+    since = (f"time since {utc_text(start)[:16].replace('T', ' ')} UTC" if start is not None
+             else "simulated time")
+    ax.set_xlabel(f"{since} [{unit}]")
+    return scale
+
+
+def gauge_figure(rows, start: datetime | None = None):
+    """Depth and water level over time at each gauge: two panels, one line per gauge (gaps
+    while a gauge is dry). ``rows`` are ``(t, id, depth, level, speed)`` as gauges.csv."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9.0, 6.5), dpi=110, layout="constrained")
+    depth_ax, level_ax = fig.subplots(2, 1, sharex=True)
+    top = max(r[0] for r in rows)
+    scale = _time_axis(level_ax, top, start)
+    for gid in dict.fromkeys(r[1] for r in rows):
+        mine = [r for r in rows if r[1] == gid]
+        t = np.array([r[0] for r in mine]) / scale
+        depth_ax.plot(t, [r[2] for r in mine], label=gid)
+        level_ax.plot(t, [r[3] for r in mine], label=gid)
+    if top > 0:
+        level_ax.set_xlim(0.0, top / scale)
+    if not any(math.isfinite(r[2]) for r in rows):
+        depth_ax.text(0.5, 0.5, "every gauge stayed dry", transform=depth_ax.transAxes,
+                      ha="center", va="center")
+    depth_ax.set_ylabel("depth [m]")
+    level_ax.set_ylabel("water level [m]")
+    depth_ax.set_title("gauges: depth and water level (gaps: dry)")
+    depth_ax.legend(fontsize=8, ncol=4, loc="upper left", title="gauge", title_fontsize=8)
+    for ax in (depth_ax, level_ax):
+        ax.grid(alpha=0.3)
+    return fig
+
+
+def mass_balance_figure(rows):
+    """The water budget over time (volume in the domain, cumulative inflow and outflow) and
+    its relative error. ``rows`` are those of ``mass_balance.csv``."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9.0, 6.0), dpi=110, layout="constrained")
+    volume_ax, error_ax = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))
+    rows = np.asarray(rows, dtype=np.float64)
+    scale = _time_axis(error_ax, float(rows[:, 0].max()), None)
+    t = rows[:, 0] / scale
+    for column, label in ((1, "in the domain"), (2, "inflow (cumulative)"),
+                          (3, "outflow (cumulative)")):
+        volume_ax.plot(t, rows[:, column], label=label)
+    volume_ax.set_ylabel("volume [m³]")
+    volume_ax.set_title("mass balance")
+    volume_ax.legend(fontsize=8)
+    error_ax.plot(t, rows[:, 5], color="k")
+    error_ax.set_ylabel("relative error [-]")
+    error_ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+    for ax in (volume_ax, error_ax):
+        ax.grid(alpha=0.3)
+    return fig

@@ -53,10 +53,14 @@ MAP_NAMES = (
 #: Quick-look PNGs written by ``floodsph.output.write_pictures`` when matplotlib is installed.
 PICTURE_NAMES = ("max_depth.png", "max_speed.png", "max_unit_discharge.png", "duration.png",
                  "hazard_uk.png", "hazard_arr.png", "arrival_time.png")
+#: Time-series PNGs (``floodsph.output.pictures.write_series_pictures``), with matplotlib.
+SERIES_PICTURE_NAMES = ("gauges.png", "mass_balance.png")
+#: The run's summary page (``floodsph.output.report``).
+REPORT_NAME = "report.html"
 #: Every file name a run writes (scenario-format.md, "Run folder"); a run's files in progress
 #: carry one of these names with a suffix (``snapshots.nc.part``, ``max_depth.tif.part``).
 RUN_FILES = (*MAP_NAMES, SNAPSHOTS_NAME, GAUGES_NAME, MASS_BALANCE_NAME, MANIFEST_NAME,
-             RESOLVED_NAME, LOG_NAME, *PICTURE_NAMES)
+             RESOLVED_NAME, LOG_NAME, *PICTURE_NAMES, *SERIES_PICTURE_NAMES, REPORT_NAME)
 BREACH_GLOB = "breach_hydrograph_*.csv"
 #: Statuses of a run whose maps are written: its folder is only replaced on request.
 FINISHED = ("completed", "stopped")

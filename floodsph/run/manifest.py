@@ -7,6 +7,7 @@ scenario), ``status`` (``"running"`` while the run is under way, then ``"complet
 ``particles_initial``, ``particles_max``, ``particles_final``, ``splits``, ``merges``,
 ``mass_error_rel``, ``threads``; and in addition ``error`` (the message of a failed run),
 ``numba_version``, ``python_version``, ``started``/``finished`` (ISO 8601, UTC),
+``start`` (the scenario's calendar start of t = 0, ISO 8601, or None without one),
 ``particle_spacing_m``, ``volume_*_m3`` totals, ``warnings`` (input problems a user could
 mean, run anyway), ``checkpoint_time_s`` (the latest checkpoint) and ``resumed_from`` (the
 checkpoint times the run was resumed from).
@@ -56,6 +57,7 @@ def new_manifest(scenario_dict: dict) -> dict:
         "merges": 0,
         "mass_error_rel": None,
         "threads": numba.get_num_threads(),
+        "start": scenario_dict.get("scenario", {}).get("start"),
         "scenario": scenario_dict,
     }
 

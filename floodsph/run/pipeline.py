@@ -6,7 +6,8 @@ particles, hydrographs; every input check happens here, before the run folder is
 -> the folder is locked and opened (``floodsph.log``, ``scenario.resolved.toml``,
 ``run.json`` with status ``"running"``) -> ``FloodModel`` (or the one of a checkpoint) ->
 ``Simulation`` with the mass-balance, progress, recorder and checkpoint callbacks -> maps,
-gauges and mass balance (written under temporary names, then renamed) -> ``run.json`` last.
+gauges and mass balance (written under temporary names, then renamed) -> quick-looks and
+``report.html`` (``floodsph.output.report``) -> ``run.json`` last.
 
 ``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached
 before the end time); ``"interrupted"`` (SIGINT, SIGTERM or SIGHUP:
@@ -177,10 +178,13 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
             log.warning("run interrupted at t = %g s: %s", model.t, manifest["error"],
                         extra=FILE_ONLY)
         else:
-            _write_outputs(manifest, recorders, mass, work)
+            features = recorders.map_features(inputs)
+            _write_outputs(manifest, recorders, mass, work, features)
             reached = model.t >= scenario.end_time_s - time_tolerance(scenario.end_time_s)
             manifest["status"] = "completed" if reached else "stopped"
             manifest["end_time_reached"] = reached
+            _finish_manifest(manifest, model, mass, time.monotonic() - wall_start)
+            manifest["report"] = recorders.write_report(manifest, mass.rows, features)
     except KeyboardInterrupt as exc:
         manifest["status"] = "interrupted"
         manifest["error"] = str(exc) or "interrupted by the user (KeyboardInterrupt)"
@@ -226,8 +230,9 @@ def _record_setup(manifest: dict, model) -> None:
                  model.volume_seed_adjustment)
 
 
-def _write_outputs(manifest: dict, recorders, mass, work: Path) -> None:
-    """Maps, gauges, snapshots, mass balance and quick-looks of a run that ended its loop.
+def _write_outputs(manifest: dict, recorders, mass, work: Path, features) -> None:
+    """Maps, gauges, snapshots, mass balance and quick-looks (with the walls, sinks and gauges
+    of ``features``) of a run that ended its loop.
 
     They are written into a temporary folder and moved into ``work`` only once all of them
     are complete, so a failure half-way (a full disk) leaves none of them.
@@ -244,7 +249,7 @@ def _write_outputs(manifest: dict, recorders, mass, work: Path) -> None:
         os.replace(path, work / path.name)
     staging.rmdir()
     log.info("wrote %d map and table files", len(written))
-    manifest["pictures"] = recorders.write_pictures()
+    manifest["pictures"] = recorders.write_pictures(features, mass.rows)
     if isinstance(manifest["pictures"], str):
         log.warning("quick-look %s", manifest["pictures"])
 

@@ -144,6 +144,13 @@ SCENARIO = TableDoc("scenario", False, "What the scenario is called and how long
     KeyDoc("end_time_s", "number", "Simulated time at which the run ends (> 0).", "s",
            required=True),
     KeyDoc("description", "string", "Free text, kept in the run manifest."),
+    KeyDoc("start", "date-time", "The calendar instant of t = 0, ISO 8601 with its time zone "
+           "(`2024-01-15T06:00:00Z`, `2024-01-15T07:00:00+01:00`; a TOML date-time or a "
+           "string). It dates the `time` of every NetCDF file (`seconds since` it, in UTC) "
+           "and adds the column `time_utc` to gauges.csv. A date-time without a time zone is "
+           "refused.", absent="no calendar start: the NetCDF times count from "
+           "1970-01-01T00:00:00Z, a placeholder with no meaning, and gauges.csv has no "
+           "time_utc column"),
 ))
 
 TERRAIN = TableDoc("terrain", False, "The ground: elevation, roughness and what happens at "

@@ -86,7 +86,7 @@ def scenario_from_dict(data: dict, *, source: str, base_dir: Path) -> Scenario:
 def _info(r: Reader, data: dict) -> ScenarioInfo:
     if "scenario" not in data:
         raise r.fail("scenario", "required table [scenario] is missing")
-    t = r.sub_table(data, "", "scenario", ("name", "end_time_s", "description"))
+    t = r.sub_table(data, "", "scenario", ("name", "end_time_s", "description", "start"))
     name = r.string(t, "scenario", "name")
     problem = name_problem(name)
     if problem is not None:
@@ -95,6 +95,7 @@ def _info(r: Reader, data: dict) -> ScenarioInfo:
         name=name,
         end_time_s=r.number(t, "scenario", "end_time_s", gt=0.0),
         description=r.string(t, "scenario", "description", ""),
+        start=r.instant(t, "scenario", "start"),
     )
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import tomllib
+from datetime import datetime
 from enum import Enum
 from pathlib import Path
 from typing import Any
@@ -185,6 +186,28 @@ class Reader:
             raise self.fail(join(path, key), f"expected a string, got {describe(value)}")
         if "\0" in value:
             raise self.fail(join(path, key), f"contains a NUL character: {value!r}")
+        return value
+
+    def instant(self, table: dict, path: str, key: str) -> datetime | None:
+        """An ISO 8601 instant with its time zone: a TOML offset date-time
+        (``2024-01-15T06:00:00Z``) or a string of one; None when absent. A date-time without a
+        time zone is refused (it could be any of 26 hours)."""
+        if key not in table:
+            return None
+        value, where = table[key], join(path, key)
+        if isinstance(value, str):
+            try:
+                value = datetime.fromisoformat(value.strip())
+            except ValueError:
+                raise self.fail(where, f"{value!r} is not an ISO 8601 date-time such as "
+                                       f"2024-01-15T06:00:00Z") from None
+        if not isinstance(value, datetime):
+            raise self.fail(where, f"expected a date-time with its time zone such as "
+                                   f"2024-01-15T06:00:00Z, got {describe(value)}")
+        if value.tzinfo is None or value.utcoffset() is None:
+            raise self.fail(where, f"{value.isoformat()} has no time zone; add Z for UTC or "
+                                   f"the offset of local time, e.g. {value.isoformat()}Z or "
+                                   f"{value.isoformat()}+01:00")
         return value
 
     def choice(self, table: dict, path: str, key: str, enum: type[Enum], default: Enum) -> Enum:

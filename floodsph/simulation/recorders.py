@@ -14,6 +14,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 from floodsph.run.folder import GAUGES_NAME, SNAPSHOTS_NAME
 from floodsph.scenario.config import Scenario
 from floodsph.simulation.schedules import TimeInterval
@@ -42,7 +44,8 @@ class Recorders:
         if gauge_points is not None:
             from floodsph.output.gauges import Gauges
 
-            self.gauges = Gauges(gauge_points, scenario.gauges.interval_s, wet_threshold=wet)
+            self.gauges = Gauges(gauge_points, scenario.gauges.interval_s, wet_threshold=wet,
+                                 start=scenario.start)
         self.snapshots = None
         if scenario.output.snapshot_interval_s > 0:
             from floodsph.output.netcdf import SnapshotWriter
@@ -50,7 +53,7 @@ class Recorders:
             self.snapshots = SnapshotWriter(
                 self.out / SNAPSHOTS_PART, self.grid, scenario=scenario.to_dict(),
                 wet_threshold=wet, keep_frames=0 if state is None else state["snapshot_frames"],
-                source=snapshots_from,
+                source=snapshots_from, start=scenario.start,
             )
         if state is not None:
             self.envelopes.restore(state["envelopes"])
@@ -95,7 +98,8 @@ class Recorders:
         from floodsph.output import write_maps
 
         formats = [f.value for f in self.scenario.output.formats]
-        written = write_maps(self.envelopes, into, formats, scenario=self.scenario.to_dict())
+        written = write_maps(self.envelopes, into, formats, scenario=self.scenario.to_dict(),
+                             start=self.scenario.start)
         if self.gauges is not None:
             written.append(self.gauges.write_csv(into / GAUGES_NAME))
         if self.snapshots is not None:
@@ -104,14 +108,52 @@ class Recorders:
             written.append(into / SNAPSHOTS_NAME)
         return written
 
-    def write_pictures(self) -> list[str] | str:
-        """Quick-look PNGs of the envelopes; their names, or ``"skipped: <reason>"``."""
-        from floodsph.output import write_pictures
+    def map_features(self, inputs):
+        """The walls, sinks and gauges of the run's ``inputs`` in world coordinates, and the
+        caption (CRS, period of the maps, calendar start) drawn with every map."""
+        from floodsph.output.pictures import MapFeatures, map_caption
 
-        result = write_pictures(self.envelopes, self.out, title=self.scenario.name)
+        t = inputs.terrain
+        origin = np.array([t.x0, t.y0])
+        gauges = () if inputs.gauges is None else tuple(
+            (gid, float(x + t.x0), float(y + t.y0))
+            for gid, x, y in zip(inputs.gauges.ids, inputs.gauges.x, inputs.gauges.y,
+                                 strict=True))
+        return MapFeatures(walls=tuple(np.asarray(w) + origin for w in inputs.walls),
+                           sinks=tuple(np.asarray(s) + origin for s in inputs.sinks),
+                           gauges=gauges,
+                           caption=map_caption(self.grid.crs_wkt, self.envelopes.t_last,
+                                               self.scenario.start))
+
+    def write_pictures(self, features=None, mass_rows=()) -> list[str] | str:
+        """Quick-look PNGs of the envelopes (with ``features``), the gauges and the mass
+        balance (``mass_rows``); their names, or ``"skipped: <reason>"``."""
+        from floodsph.output import write_pictures
+        from floodsph.output.pictures import write_series_pictures
+
+        result = write_pictures(self.envelopes, self.out, title=self.scenario.name,
+                                features=features)
         if isinstance(result, str):
             return "skipped: " + result.removeprefix("pictures skipped: ")
+        result += write_series_pictures(None if self.gauges is None else self.gauges.rows,
+                                        mass_rows, self.out, self.scenario.start)
         return [Path(path).name for path in result]
+
+    def write_report(self, manifest: dict, mass_rows, features) -> str:
+        """Write ``report.html`` (:mod:`floodsph.output.report`) beside the quick-looks
+        listed in ``manifest["pictures"]``; its name, with a note when it has no pictures."""
+        from floodsph.output.report import write_report
+        from floodsph.run.atomic_files import atomic_path
+        from floodsph.run.folder import REPORT_NAME
+
+        drawn = not isinstance(manifest.get("pictures"), str)
+        with atomic_path(self.out / REPORT_NAME) as tmp:
+            write_report(tmp, manifest=manifest, envelopes=self.envelopes,
+                         caption=features.caption,
+                         gauge_rows=() if self.gauges is None else self.gauges.rows,
+                         mass_rows=mass_rows, start=self.scenario.start,
+                         pictures=self.out if drawn else None)
+        return REPORT_NAME if drawn else f"{REPORT_NAME} (tables only: {manifest['pictures']})"
 
     def close(self) -> None:
         if self.snapshots is not None:

@@ -2,7 +2,8 @@
 
 The run: the conftest valley with water at level 101 m held in its western 200 m (3 m deep
 in the basin, 1 m on the floor), released at t = 0 onto the dry eastern floor (a dam break),
-6 s, snapshots every 2 s. The attributes are checked
+6 s, snapshots every 2 s, one gauge, a calendar start at 07:00 on 15 January 2024 in UTC+1.
+The attributes are checked
 against the CF rules themselves (coordinate variables without _FillValue, flag values that
 are the class values, time units that a CF time library decodes, standard names of the CF
 table), then, where installed (``pip install floodsph[cf]``), by the CF checker (cfchecks:
@@ -11,8 +12,10 @@ no error, no warning) and the IOOS compliance checker (no high-priority failure)
 
 from __future__ import annotations
 
+import csv
 import importlib.util
 import json
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 import netCDF4
@@ -26,10 +29,13 @@ from floodsph.run.pipeline import run_scenario
 from floodsph.scenario.reader import load_scenario
 
 END_S, SNAPSHOT_S, WET_M, DAM_M = 6.0, 2.0, 0.02, 200.0
+START = "2024-01-15T07:00:00+01:00"
+START_UTC = datetime(2024, 1, 15, 6, tzinfo=UTC)
 DAM_BREAK = f"""
 [scenario]
 name = "cf"
 end_time_s = {END_S}
+start = {START}
 
 [terrain]
 dem = "dem.tif"
@@ -49,6 +55,10 @@ refinement = "none"
 resolution_m = 10.0
 wet_threshold_m = {WET_M}
 snapshot_interval_s = {SNAPSHOT_S}
+
+[gauges]
+file = "gauges.csv"
+interval_s = 2.0
 """
 NETCDF_FILES = ("flood_maps.nc", "snapshots.nc")
 
@@ -58,6 +68,7 @@ def run_dir(tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("cf")
     write_geotiff(folder / "dem.tif", valley_elevation())
     (folder / "scenario.toml").write_text(DAM_BREAK)
+    (folder / "gauges.csv").write_text(f"id,x,y\nfloor,{X0 + 250},{Y0 + 100}\n")
     manifest = run_scenario(load_scenario(folder / "scenario.toml"), folder / "out",
                             progress=False)
     assert manifest["status"] == "completed"
@@ -146,19 +157,33 @@ def test_threshold_and_period_coordinates(run_dir):
         assert json.loads(ds.scenario)["output"]["wet_threshold_m"] == WET_M
 
 
-def test_snapshot_times_decode_to_the_documented_reference(run_dir):
+def test_times_are_dated_from_the_scenario_start(run_dir):
+    """``start = 2024-01-15T07:00:00+01:00``: every NetCDF time decodes (cftime) to that
+    instant, 06:00 UTC, plus the simulated seconds; gauges.csv has the same instants and
+    run.json records the start."""
     import cftime
-
-    from floodsph.output.cf import TIME_REFERENCE
 
     with netCDF4.Dataset(run_dir / "snapshots.nc") as ds:
         t = ds["time"]
-        dates = cftime.num2date(t[:], t.units, t.calendar)
-        assert TIME_REFERENCE in t.comment
+        assert t.units == "seconds since 2024-01-15 06:00:00"
+        dates = cftime.num2date(t[:], t.units, t.calendar, only_use_cftime_datetimes=False)
         seconds = t[:]
-    start = cftime.num2date(0.0, f"seconds since {TIME_REFERENCE}", "standard")
-    assert [(d - start).total_seconds() for d in dates] == pytest.approx(list(seconds))
+    assert [(d.replace(tzinfo=UTC) - START_UTC).total_seconds() for d in dates] == \
+        pytest.approx(list(seconds), abs=1e-5)
     assert seconds[0] == 0.0 and np.allclose(np.diff(seconds), SNAPSHOT_S, atol=0.5)
+    with netCDF4.Dataset(run_dir / "flood_maps.nc") as ds:
+        end = cftime.num2date(ds["time"][...], ds["time"].units, ds["time"].calendar,
+                              only_use_cftime_datetimes=False)
+    assert end.replace(tzinfo=UTC) == pytest.approx(START_UTC + timedelta(seconds=END_S),
+                                                    abs=timedelta(seconds=1))
+    with open(run_dir / "gauges.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert rows and list(rows[0])[-1] == "time_utc"
+    for row in rows:
+        instant = datetime.fromisoformat(row["time_utc"])
+        assert instant - START_UTC == timedelta(seconds=float(row["time_s"]))
+    manifest = json.loads((run_dir / "run.json").read_text())
+    assert datetime.fromisoformat(manifest["start"]) == START_UTC
 
 
 def _cf_tables(folder: Path) -> dict:

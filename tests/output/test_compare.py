@@ -1,5 +1,6 @@
 """Map comparison: contingency scores on hand-built maps, alignment of shifted grids, CLI."""
 
+import csv
 import json
 import math
 
@@ -12,7 +13,7 @@ from rasterio.transform import from_origin
 
 from floodsph.cli.compare import command
 from floodsph.errors import InputError
-from floodsph.output.compare import compare, scores
+from floodsph.output.compare import compare, scores, write_outputs
 
 CELL = 10.0
 WEST, NORTH = 500000.0, 4200000.0
@@ -161,7 +162,8 @@ def test_a_netcdf_variable_gives_the_numbers_of_its_geotiff(tmp_path, name):
     from_tif = compare(tmp_path / f"{name}.tif", reference)
     from_nc = compare(f"{nc}:{name}", reference)
     from_both = compare(f"{nc}:{name}", f"{tmp_path / 'ref' / 'flood_maps.nc'}:{name}")
-    expected_kind = {"max_depth": "depth", "arrival_time": "arrival", "hazard_uk": "class"}
+    expected_kind = {"max_depth": "depth", "arrival_time": "arrival",
+                     "hazard_uk": "hazard_uk"}
     assert from_tif.summary["kind"] == expected_kind[name]
     assert from_tif.summary["hits"] > 0 and from_tif.summary["misses"] > 0
     for other in (from_nc, from_both):
@@ -203,3 +205,90 @@ def test_compare_errors_name_the_map_at_fault(tmp_path):
     with rasterio.open(two, "w", **profile) as dst:
         dst.write(np.ones((2, 4, 4), dtype=np.float32))
     assert_one_message(compare_cli(tif, two), f"{two} has 2 bands")
+
+
+def test_maps_of_different_quantities_are_refused_naming_both(tmp_path):
+    model, _ = shifted_maps()
+    model["max_speed"] = model["max_depth"] * 2
+    model["duration"] = np.where(np.isfinite(model["max_depth"]), 600.0, np.nan).astype(
+        np.float32)
+    nc = netcdf_and_geotiffs(tmp_path, model)
+    depth = tmp_path / "max_depth.tif"
+    assert_one_message(compare_cli(depth, f"{nc}:max_speed"),
+                       f"{depth} is a depth map (band description 'max_depth')",
+                       f"{nc}:max_speed is a speed map (standard_name 'flood_water_speed')",
+                       "same quantity")
+    assert_one_message(compare_cli(depth, tmp_path / "duration.tif"),
+                       f"{tmp_path / 'duration.tif'} is a wet-duration map")
+    assert_one_message(compare_cli(tmp_path / "arrival_time.tif", depth),
+                       "arrival_time.tif is an arrival-time map (band description")
+    assert_one_message(compare_cli(depth, tmp_path / "hazard_uk.tif"), "a UK-hazard-class map")
+    assert_one_message(compare_cli(depth, depth, "--arrival"),
+                       f"{depth} is a depth map", "--arrival asks for arrival times")
+
+
+def test_a_map_without_metadata_takes_the_quantity_of_the_other(tmp_path):
+    """A benchmark raster without description or units is compared as what the model map
+    holds: a speed map's wet cells are those with a value, not those above 0.1 m."""
+    model, _ = shifted_maps()
+    speed = np.where(np.isfinite(model["max_depth"]), 0.05, np.nan).astype(np.float32)
+    model["max_speed"] = speed
+    netcdf_and_geotiffs(tmp_path, model)
+    bare = write(tmp_path / "bare.tif", speed)
+    s = compare(tmp_path / "max_speed.tif", bare).summary
+    assert s["kind"] == "speed" and s["threshold_m"] is None
+    assert s["hits"] == 80 and s["speed"]["rmse"] == pytest.approx(0.0, abs=1e-7)
+
+
+def test_points_off_the_map_are_rows_marked_outside(tmp_path):
+    depth = np.zeros((5, 5), dtype=np.float32)
+    depth[:, 0] = 2.0
+    d = write(tmp_path / "d.tif", depth)
+    obs = tmp_path / "hwm.csv"
+    obs.write_text(f"id,x,y,observed\nP1,{WEST + 5},{NORTH - 15},1.5\n"
+                   f"FAR,{WEST + 5000},{NORTH - 15},1.0\n"
+                   f"P2,{WEST + 25},{NORTH - 15},0.5\n")
+    out = tmp_path / "cmp"
+    result = compare_cli(d, d, "--points", obs, "--out", out)
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "comparison.json").read_text())
+    assert summary["points"]["n"] == 2 and summary["points"]["outside"] == ["FAR"]
+    assert summary["points"]["rmse"] == pytest.approx(0.5)
+    with open(out / "points.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["id"] for r in rows] == ["P1", "FAR", "P2"]
+    assert list(rows[0]) == ["id", "x", "y", "observed", "modelled", "error", "status"]
+    assert float(rows[0]["modelled"]) == 2.0 and float(rows[0]["error"]) == pytest.approx(0.5)
+    assert rows[1]["status"] == "outside" and rows[1]["modelled"] == "nan"
+    assert rows[2]["status"] == "compared" and float(rows[2]["error"]) == pytest.approx(-0.5)
+
+
+def test_difference_map_is_a_valid_cloud_optimized_geotiff(tmp_path):
+    """On a map larger than one 512-cell tile: tiled, with internal overviews, in the COG
+    layout (rio-cogeo's validator, strict: warnings count as failures)."""
+    cog = pytest.importorskip("rio_cogeo.cogeo")
+    depth = np.zeros((700, 900), dtype=np.float32)
+    depth[100:600, 100:800] = 1.5
+    a = write(tmp_path / "a.tif", depth)
+    b = write(tmp_path / "b.tif", np.roll(depth, 7, axis=1))
+    diff = write_outputs(compare(a, b), tmp_path / "cmp")[0]
+    valid, problems, warns = cog.cog_validate(diff, strict=True)
+    assert valid, (problems, warns)
+    with rasterio.open(diff) as src:
+        assert src.overviews(1) and src.profile["tiled"]
+        assert src.units[0] == "m" and src.crs == CRS.from_epsg(32633)
+        assert src.read(1)[300, 103] == pytest.approx(1.5)
+
+
+def test_every_map_of_a_run_has_its_own_quantity_with_its_units():
+    from floodsph.output.envelopes import CLASS_MAPS, MAPS
+    from floodsph.output.quantities import MapMetadata, identify
+
+    found = {}
+    for name, (long_name, units, _) in MAPS.items():
+        meta = MapMetadata(description=name, long_name=long_name, units=units,
+                           integer=name in CLASS_MAPS)
+        quantity, evidence = identify(meta)
+        assert quantity.units == units and evidence == f"band description {name!r}"
+        found[name] = quantity.name
+    assert len(set(found.values())) == len(MAPS), found

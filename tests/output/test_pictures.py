@@ -68,6 +68,7 @@ def test_hazard_class_names_do_not_overlap_each_other_or_the_map(envelopes):
 def test_comparison_legend_stays_clear_of_both_panels():
     from floodsph.output.compare import Comparison
     from floodsph.output.map_source import Raster
+    from floodsph.output.quantities import BY_NAME
 
     categories = np.zeros((40, 60), dtype=np.uint8)
     categories[:, :] = 1
@@ -75,7 +76,7 @@ def test_comparison_legend_stays_clear_of_both_panels():
     categories[10:20, 30:35] = 3
     categories[20:25, 10:30] = 4
     model = Raster("m.tif", np.zeros((40, 60)), from_origin(500000.0, 4200000.0, 10.0, 10.0),
-                   CRS.from_epsg(32633), "depth")
+                   CRS.from_epsg(32633), BY_NAME["depth"])
     summary = {"csi": 0.6, "hit_rate": 0.667, "kind": "depth"}
     fig = comparison_figure(Comparison(summary, np.zeros((40, 60)), categories, model))
     renderer = drawn(fig)
@@ -115,3 +116,57 @@ def test_time_unit_follows_the_range():
     assert time_unit(90.0) == (1.0, "s")
     assert time_unit(600.0) == (60.0, "min")
     assert time_unit(5 * 3600.0) == (3600.0, "h")
+
+
+def test_depth_quick_look_is_drawn_in_the_depth_bands(envelopes):
+    """Depths take the colour of their band, the same colours as the report's area table
+    (a linear ramp from 0 to the deepest 2 m gave 0.2 m a near-white colour); a depth on a
+    limit (1 m) is in the deeper band, in the picture as in the table."""
+    from matplotlib.colors import to_hex
+
+    from floodsph.output.areas import area_by_depth, depth_bands
+
+    fig = map_figure(envelopes, "max_depth")
+    image = fig.axes[0].get_images()[-1]
+    bands = {b.label: b.colour for b in depth_bands(envelopes.wet_threshold)}
+    for depth, label in ((0.2, "0.15 to 0.3 m"), (0.7, "0.5 to 1 m"), (1.0, "1 to 2 m"),
+                         (1.5, "1 to 2 m"), (2.0, "2 to 5 m"), (7.0, "more than 5 m")):
+        assert to_hex(image.to_rgba(depth)) == bands[label], depth
+        rows = area_by_depth(np.array([depth]), 1.0, envelopes.wet_threshold)
+        assert [r.label for r in rows if r.cells] == [label]
+    assert to_hex(image.to_rgba(0.2)) != to_hex(image.to_rgba(0.3))
+
+
+def test_walls_sinks_gauges_and_the_caption_are_drawn(envelopes):
+    from floodsph.output.pictures import MapFeatures, map_caption
+
+    caption = map_caption(envelopes.grid.crs_wkt, 600.0, None)
+    assert caption == ("CRS: WGS 84 / UTM zone 32N (EPSG:32632); maxima over t = 0 to 600 s "
+                       "(no calendar start)")
+    wall = np.array([[X0 + 100.0, Y0 + 20.0], [X0 + 100.0, Y0 + 180.0]])
+    sink = np.array([[X0 + 250.0, Y0], [X0 + 300.0, Y0], [X0 + 300.0, Y0 + 50.0]])
+    features = MapFeatures(walls=(wall,), sinks=(sink,), gauges=(("G7", X0 + 40.0, Y0 + 60.0),),
+                           caption=caption)
+    for name in ("max_depth", "hazard_uk", "arrival_time"):
+        fig = map_figure(envelopes, name, features=features)
+        ax = fig.axes[0]
+        lines = [line.get_xydata() for line in ax.get_lines()]
+        assert any(np.allclose(xy, wall / 1e3) for xy in lines), name
+        assert any(len(xy) == 4 and np.allclose(xy[:3], sink / 1e3) for xy in lines), name
+        assert "G7" in [t.get_text() for t in ax.texts], name
+        assert fig.get_supxlabel() == caption
+
+
+def test_gauge_plot_spans_the_run_and_says_when_every_gauge_stayed_dry():
+    from floodsph.output.pictures import gauge_figure
+
+    nan = float("nan")
+    rows = [(t, "G1", nan, nan, nan) for t in (0.0, 30.0, 60.0)]
+    depth_ax, level_ax = gauge_figure(rows).axes[:2]
+    assert level_ax.get_xlim() == (0.0, 60.0)
+    assert [t.get_text() for t in depth_ax.texts] == ["every gauge stayed dry"]
+    wet = [(0.0, "G1", nan, nan, nan), (30.0, "G1", 0.4, 100.4, 1.0), (60.0, "G1", 0.9, 100.9,
+                                                                           1.2)]
+    depth_ax, _ = gauge_figure(wet).axes[:2]
+    assert not depth_ax.texts
+    assert np.allclose(depth_ax.get_lines()[0].get_xydata()[1:], [[30.0, 0.4], [60.0, 0.9]])

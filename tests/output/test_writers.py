@@ -10,6 +10,7 @@ import xarray as xr
 from rasterio.crs import CRS
 from rasterio.transform import from_origin
 
+import floodsph
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
 from floodsph.model.terrain import Terrain
@@ -143,7 +144,7 @@ def test_snapshots_append_along_unlimited_time(terrain, tmp_path):
         w.append(0.0, d, d * 0, d * 0)
         w.append(5.0, d * 2, d * 0 + 1, d * 0)
     with xr.open_dataset(tmp_path / "snapshots.nc") as ds:
-        # seconds since the fixed reference 1970-01-01 (floodsph.output.cf.TIME_REFERENCE)
+        # no start: seconds since the placeholder 1970-01-01 (floodsph.output.cf.NO_START)
         assert list(ds["time"].values) == [np.datetime64("1970-01-01T00:00:00"),
                                            np.datetime64("1970-01-01T00:00:05")]
         assert ds.encoding["unlimited_dims"] == {"time"}
@@ -195,3 +196,41 @@ def test_result_tables_format_floats_and_nan(tmp_path):
     assert path.read_text().splitlines() == ["case,wall_s,l1,n", "a,12.346,nan,3"]
     assert markdown(rows, ["case", "wall_s"]).splitlines() == [
         "| case | wall_s |", "|---|---|", "| a | 12.35 |"]
+
+
+@pytest.mark.parametrize("start", [None, "2024-01-15T07:00:00+01:00"])
+def test_maps_are_the_same_dataset_whatever_formats_the_run_wrote(envelopes, tmp_path, start):
+    """``open_run(folder).maps()`` from GeoTIFFs only, NetCDF only and both: identical
+    variables, values, dtypes (class maps uint8), flags, attributes, coordinates and dated
+    time; only ``history`` (when the file read was written) may differ."""
+    from datetime import UTC, datetime, timedelta
+
+    from floodsph.run.manifest import write_manifest
+    from floodsph.run.results import open_run
+
+    scenario = {"scenario": {"name": "formats", "end_time_s": 2.0}}
+    if start is not None:
+        scenario["scenario"]["start"] = start
+    got = {}
+    for formats in (("geotiff",), ("netcdf",), ("geotiff", "netcdf")):
+        folder = tmp_path / "+".join(formats)
+        write_maps(envelopes, folder, formats, scenario=scenario,
+                   start=None if start is None else datetime.fromisoformat(start))
+        write_manifest(folder, {"status": "completed", "scenario": scenario, "start": start})
+        got[formats] = open_run(folder).maps()
+    both = got[("geotiff", "netcdf")]
+    assert both["hazard_uk"].dtype == np.uint8 and both["hazard_arr"].dtype == np.uint8
+    assert both["hazard_uk"].attrs["flag_values"].dtype == np.uint8
+    assert both["hazard_uk"].attrs["flag_meanings"].split()[0] == "dry"
+    assert both.attrs["wet_threshold_m"] == 0.05
+    assert json.loads(both.attrs["scenario"]) == scenario
+    epoch = datetime(2024, 1, 15, 6, tzinfo=UTC) if start else datetime(1970, 1, 1, tzinfo=UTC)
+    end = (epoch + timedelta(seconds=envelopes.t_last)).replace(tzinfo=None)
+    assert both["time"].values == np.datetime64(end)
+    assert int(np.isnan(both["max_depth"]).sum()) > 0      # never-wet cells are NaN
+    for formats, ds in got.items():
+        assert ds.attrs["history"].endswith(" written by floodsph " + floodsph.__version__)
+        ds = ds.assign_attrs(history=both.attrs["history"])
+        xr.testing.assert_identical(ds, both)
+        for name in ds.variables:
+            assert ds[name].dtype == both[name].dtype, (formats, name)

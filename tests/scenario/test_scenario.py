@@ -267,3 +267,32 @@ def test_worldcover_manning_table_from_toml(write_scenario, tmp_path):
     resolved = tmp_path / "resolved.toml"
     write_resolved(sc, resolved)
     assert load_scenario(resolved).terrain.manning_table == "worldcover"
+
+
+@pytest.mark.parametrize("value", ["2024-01-15T07:00:00+01:00", '"2024-01-15T07:00:00+01:00"',
+                                   '"2024-01-15T06:00:00Z"', "2024-01-15 06:00:00Z"])
+def test_start_is_a_time_zone_aware_instant(write_scenario, tmp_path, value):
+    """A TOML offset date-time or an ISO 8601 string; the same instant whatever its offset,
+    kept through the resolved copy."""
+    from datetime import UTC, datetime
+
+    text = MINIMAL.replace("end_time_s = 60\n", f"end_time_s = 60\nstart = {value}\n")
+    sc = load_scenario(write_scenario(text))
+    assert sc.start == datetime(2024, 1, 15, 6, tzinfo=UTC) and sc.start.utcoffset() is not None
+    write_resolved(sc, tmp_path / "scenario.resolved.toml")
+    assert load_scenario(tmp_path / "scenario.resolved.toml").start == sc.start
+    assert load_scenario(write_scenario(MINIMAL)).start is None
+
+
+@pytest.mark.parametrize("value, message", [
+    ("2024-01-15T06:00:00", "scenario.start: 2024-01-15T06:00:00 has no time zone; add Z"),
+    ('"2024-01-15 06:00"', "scenario.start: 2024-01-15T06:00:00 has no time zone"),
+    ('"15/01/2024 06:00"', "scenario.start: '15/01/2024 06:00' is not an ISO 8601 date-time"),
+    ("2024-01-15", "scenario.start: expected a date-time with its time zone"),
+    ("3600", "scenario.start: expected a date-time with its time zone"),
+])
+def test_a_start_without_time_zone_or_not_a_date_time_is_refused(write_scenario, value,
+                                                                 message):
+    text = MINIMAL.replace("end_time_s = 60\n", f"end_time_s = 60\nstart = {value}\n")
+    with pytest.raises(InputError, match="scenario.toml: " + message.replace("(", r"\(")):
+        load_scenario(write_scenario(text))
