@@ -63,16 +63,13 @@ def final_status(completed: int, failed: int) -> str:
     return "completed_with_failures" if failed else "completed"
 
 
-def _atomic_write(path: Path, text: str) -> Path:
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8", newline="")
-    return path
-
-
 def write_manifest(folder: Path, manifest: dict) -> Path:
     """Write ``folder/ensemble.json``."""
-    return _atomic_write(Path(folder) / ENSEMBLE_JSON,
-                         json.dumps(json_safe(manifest), indent=2, allow_nan=False) + "\n")
+    path = Path(folder) / ENSEMBLE_JSON
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(json_safe(manifest), indent=2, allow_nan=False) + "\n",
+                       encoding="utf-8")
+    return path
 
 
 def read_manifest(folder: Path) -> dict | None:
@@ -105,4 +102,7 @@ def write_samples(folder: Path, keys, ids, rows, results: dict) -> Path:
         wall = None if result is None else result.wall_time_s
         error = None if result is None else result.error
         writer.writerow([mid, *(_cell(v) for v in drawn), status, _cell(wall), _cell(error)])
-    return _atomic_write(Path(folder) / SAMPLES_CSV, buffer.getvalue())
+    path = Path(folder) / SAMPLES_CSV
+    with atomic_path(path) as tmp:
+        tmp.write_text(buffer.getvalue(), encoding="utf-8", newline="")
+    return path

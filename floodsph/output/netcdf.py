@@ -34,6 +34,7 @@ from floodsph.output.cf import (
     no_fill,
     variable_attrs,
 )
+from floodsph.run.atomic_files import atomic_path
 
 
 def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
@@ -98,9 +99,8 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
         if name in data_vars:
             data_vars[name].encoding["coordinates"] = None
     ds = xr.Dataset(data_vars, coords=coords, attrs=global_attrs(title, scenario, wet_threshold))
-    part = path.with_name(path.name + ".part")
-    ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
-    os.replace(part, path)
+    with atomic_path(path) as part:
+        ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
     return path
 
 

@@ -289,8 +289,7 @@ def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]
                                                  strict=True)):
         if inflow.breach is not None:
             name = f"breach_hydrograph_{i}.csv"
-            with atomic_path(out / name) as tmp:
-                write_hydrograph_csv(tmp, hydrograph.t, hydrograph.Q)
+            write_hydrograph_csv(out / name, hydrograph.t, hydrograph.Q)
             names.append(name)
     return names
 
