@@ -14,23 +14,20 @@ import click
 def command(scenario: Path, output) -> None:
     """Validate SCENARIO (a TOML file) without running it.
 
-    Loads the scenario, the DEM and roughness, builds the initial water and seeds the
-    particles, then prints the domain size, CRS, water volumes, particle count and the
-    estimated peak memory. Exits with status 2 and one message on any input problem, including
-    a run whose memory estimate exceeds the memory available, and a run folder that a run
-    could not write (a file, not writable, holding files that are not a run's).
+    Makes every test a run makes before its first step (the same function), then prints the
+    domain size, CRS, water volumes, particle count and the estimated peak memory. Exits with
+    status 2 and one message on any input problem, including a run whose memory estimate
+    exceeds the memory available, and a run folder that a run could not write (a file, not
+    writable, holding files that are not a run's).
     """
-    from floodsph.inputs.memory import available_memory, check_memory
-    from floodsph.inputs.prepare import prepare_inputs, summary_lines
-    from floodsph.run.folder import RunFolder
+    from floodsph.inputs.memory import available_memory
+    from floodsph.inputs.prepare import summary_lines
+    from floodsph.run.preflight import preflight
     from floodsph.scenario.reader import load_scenario
 
     sc = load_scenario(scenario)
-    output = None if output is None else Path(output)
-    RunFolder(output or sc.output_directory, sc.input_files(), overwrite=True).check()
-    inputs = prepare_inputs(sc)
+    inputs = preflight(sc, None if output is None else Path(output), overwrite=True).inputs
     available, _ = available_memory()
     for line in summary_lines(sc, inputs, available):
         click.echo(line)
-    check_memory(inputs.memory, str(scenario))
     click.echo("OK: the scenario is valid.")

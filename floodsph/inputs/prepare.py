@@ -13,7 +13,8 @@ created (``floodsph check`` stops after it and prints :func:`summary_lines`):
    (``floodsph.checks.placement``);
 5. build the initial depth grid: the deepest of all ``[[initial_water]]`` bodies per cell
    (two overlapping still-water bodies hold the higher level, not the sum); refuse a
-   scenario without water (``floodsph.checks.water``);
+   scenario without water (``floodsph.checks.water``) and an inflow without a side to enter
+   on (``floodsph.checks.inflows``);
 6. estimate the memory again from the wet area (particles = wet area / spacing^2) and
    refuse before seeding; seed particles on the lattice of spacing
    ``numerics.particle_spacing_m`` (default: the DEM cell size);
@@ -31,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.checks.inflows import check_inflows
 from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
@@ -96,6 +98,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     dry: list[str] = []
     depth = initial_depth(scenario, terrain, wet, dry)
     check_has_water(scenario, dry, bool(np.any(depth > 0.0)), v_in, source, warnings)
+    check_inflows(scenario, terrain, depth, spacing, source, warnings)
     out_cells = output_cells(scenario, terrain.shape, terrain.dx, terrain.dy)
     n_wet = np.count_nonzero(depth > 0.0) * terrain.dx * terrain.dy / spacing / spacing
     lattice = lattice_cells(terrain.width, terrain.height, spacing)

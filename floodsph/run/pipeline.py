@@ -1,12 +1,13 @@
 """``run_scenario``: one scenario from its TOML to a finished run folder.
 
-The chain (architecture.md 3.2): the run folder is checked (``floodsph.run.folder``: nothing
-that is not a floodsph run's, no completed run unless replaced) -> inputs (terrain,
-particles, hydrographs; every input check happens here, before the run folder is touched)
--> the folder is locked and opened (``floodsph.log``, ``scenario.resolved.toml``,
-``run.json`` with status ``"running"``) -> ``FloodModel`` (or the one of a checkpoint) ->
-``Simulation`` with the mass-balance, progress, recorder and checkpoint callbacks -> maps,
-gauges and mass balance (written under temporary names, then renamed) -> ``run.json`` last.
+The chain (architecture.md 3.2): every test ``floodsph check`` makes, in the one function
+both call (``floodsph.run.preflight``: the run folder, with nothing that is not a floodsph
+run's and no completed run unless replaced; the inputs -- terrain, particles, hydrographs,
+inflow sides, memory -- all before the run folder is touched) -> the folder is locked and
+opened (``floodsph.log``, ``scenario.resolved.toml``, ``run.json`` with status
+``"running"``) -> ``FloodModel`` (or the one of a checkpoint) -> ``Simulation`` with the
+mass-balance, progress, recorder and checkpoint callbacks -> maps, gauges and mass balance
+(written under temporary names, then renamed) -> ``run.json`` last.
 
 ``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached
 before the end time); ``"interrupted"`` (SIGINT, SIGTERM or SIGHUP:
@@ -81,20 +82,13 @@ def run_scenario(
     InputError
         Bad input, a run folder the run may not write, or a run too large for the memory.
     """
-    from floodsph.inputs.memory import check_memory
-    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.run.preflight import preflight
 
-    if overwrite and resume:
-        raise InputError("--overwrite and --resume exclude each other: resume continues the "
-                         "run in the folder, overwrite replaces it")
-    out = Path(out_dir) if out_dir is not None else scenario.output_directory
-    folder = RunFolder(out, scenario.input_files(), overwrite=overwrite, resume=resume)
-    folder.check()
     with StopSignals() as stop:
         used_threads = set_threads(scenario.numerics.threads if threads is None else threads)
-        inputs = prepare_inputs(scenario)
-        check_memory(inputs.memory, str(scenario.path.name))
-        checkpoint = _resumable(folder, scenario, inputs, used_threads) if resume else None
+        checked = preflight(scenario, out_dir, overwrite=overwrite, resume=resume,
+                            threads=used_threads)
+        inputs, folder, checkpoint = checked.inputs, checked.folder, checked.checkpoint
         work = folder.open()
         try:
             return _run(scenario, inputs, folder, work, checkpoint, stop,
@@ -111,27 +105,6 @@ class RunOptions:
     progress: bool
     threads: int
     callbacks: tuple
-
-
-def _resumable(folder: RunFolder, scenario: Scenario, inputs, threads: int):
-    """The checkpoint to resume from, refused unless the scenario is the same."""
-    from floodsph.simulation.checkpoint import load_checkpoint, scenario_difference
-
-    directory = folder.checkpoint_dir()
-    checkpoint = load_checkpoint(directory, inputs.terrain)
-    where = scenario_difference(checkpoint.scenario, scenario.to_dict())
-    if where is not None:
-        raise InputError(f"{scenario.path}: {where} differs from the checkpointed run's "
-                         f"({directory}); only scenario.end_time_s may change on --resume")
-    if checkpoint.t >= scenario.end_time_s - time_tolerance(scenario.end_time_s):
-        raise InputError(f"{scenario.path}: scenario.end_time_s = {scenario.end_time_s:g} s "
-                         f"is not after the checkpoint at t = {checkpoint.t:g} s; raise it "
-                         "to extend the run")
-    if checkpoint.threads != threads:
-        log.warning("the checkpoint was written with %d threads, this run has %d: the resumed "
-                    "run may differ from an uninterrupted one in the last digits",
-                    checkpoint.threads, threads)
-    return checkpoint
 
 
 def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
