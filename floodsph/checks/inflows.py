@@ -31,6 +31,7 @@ import numpy as np
 
 from floodsph.errors import InputError, warn
 
+
 def inward_normal(a, b, terrain, direction, spacing: float, name: str) -> np.ndarray:
     """The unit normal of the line A-B (local coordinates [m]) towards the domain.
 

@@ -53,6 +53,7 @@ def run_scenario(
     threads: int | None = None,
     callbacks=(),
     resume: bool = False,
+    stop_requested=None,
 ) -> dict:
     """Run ``scenario`` and write its run folder; return the manifest (``run.json``).
 
@@ -76,6 +77,10 @@ def run_scenario(
     resume : bool
         Continue from the latest checkpoint in ``out_dir``; the scenario must equal the
         checkpointed one but for a later ``end_time_s``.
+    stop_requested : callable, optional
+        ``stop_requested() -> reason or None``, asked after every step: a reason ends the run
+        as a stop signal does (checkpoint, status ``"interrupted"``). An ensemble's member
+        on a dask worker is stopped this way.
 
     Raises
     ------
@@ -84,7 +89,7 @@ def run_scenario(
     """
     from floodsph.run.preflight import preflight
 
-    with StopSignals() as stop:
+    with StopSignals(external=stop_requested) as stop:
         used_threads = set_threads(scenario.numerics.threads if threads is None else threads)
         checked = preflight(scenario, out_dir, overwrite=overwrite, resume=resume,
                             threads=used_threads)
