@@ -62,11 +62,13 @@ class EnsemblePlan:
 
 @dataclass(frozen=True)
 class BaseSetup:
-    """What every member shares: the map grid, its DEM mask and a member's memory estimate."""
+    """What every member shares: the map grid, its DEM mask and a member's memory estimate;
+    and the base scenario's ``floodsph check`` summary (``summary_lines``)."""
 
     grid: OutputGrid
     inside: np.ndarray
     member_bytes: int
+    summary: tuple[str, ...] = ()
 
 
 def run_ensemble(spec: EnsembleSpec, out_dir: str | Path | None = None, *,
@@ -173,6 +175,43 @@ def prepare_ensemble(spec: EnsembleSpec, out_dir: str | Path | None = None, *,
     return EnsemblePlan(out, base, samples, members, previous, prepare_base(base))
 
 
+def check_extreme_members(spec: EnsembleSpec, plan: EnsemblePlan) -> list[str]:
+    """Prepare the inputs (``floodsph.inputs.prepare.prepare_inputs``) of the members that
+    drew the lowest and the highest value of each parameter, where a sampled value is most
+    likely refused by the inputs (a reservoir level below its bed, say); returns their ids.
+
+    Members that scale a raster are left out (their rasters are written when they run).
+    """
+    import tomllib
+
+    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.scenario.reader import scenario_from_dict
+
+    picked: list[int] = []
+    for j in range(len(plan.samples.keys)):
+        column = [row[j] for row in plan.samples.rows]
+        if all(isinstance(v, int | float) for v in column):
+            picked += [int(np.argmin(column)), int(np.argmax(column))]
+    checked = []
+    for m in dict.fromkeys(picked):
+        member = plan.members[m]
+        if member.rasters:
+            continue
+        source = f"{spec.path.name}: member {member.id}"
+        scenario = scenario_from_dict(tomllib.loads(member.scenario_text), source=source,
+                                      base_dir=spec.path.parent)
+        try:
+            prepare_inputs(scenario)
+        except InputError as exc:
+            drawn = "; ".join(f"{key} = {value:.6g}" if isinstance(value, float)
+                              else f"{key} = {value}"
+                              for key, value in zip(plan.samples.keys, plan.samples.rows[m],
+                                                    strict=True))
+            raise InputError(f"{exc} (the member's sampled values: {drawn})") from None
+        checked.append(member.id)
+    return checked
+
+
 def _record_interrupted(to_run, results: dict, reason: str) -> None:
     """Members that were running when the ensemble was interrupted: ``interrupted`` in
     ``results`` and in their own ``run.json`` (left at ``running`` by the closed worker)."""
@@ -216,13 +255,13 @@ def _check_folder(out: Path, resume: bool, overwrite: bool) -> dict | None:
 def prepare_base(base) -> BaseSetup:
     """The base scenario's inputs: the map grid, DEM mask and memory estimate (checked)."""
     from floodsph.ensemble.aggregate import dem_mask
-    from floodsph.inputs.memory import check_memory
-    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.inputs.memory import available_memory
+    from floodsph.inputs.prepare import prepare_inputs, summary_lines
 
-    inputs = prepare_inputs(base)
-    check_memory(inputs.memory, base.path.name)
+    inputs = prepare_inputs(base)  # refuses a member too large for the memory
     grid = OutputGrid.from_terrain(inputs.terrain, base.output.resolution_m)
-    return BaseSetup(grid, dem_mask(inputs.terrain, grid), inputs.memory.total)
+    summary = tuple(summary_lines(base, inputs, available_memory()[0]))
+    return BaseSetup(grid, dem_mask(inputs.terrain, grid), inputs.memory.total, summary)
 
 
 def _run_members(to_run, out: Path, manifest, results, setup: BaseSetup, scheduler, workers,
