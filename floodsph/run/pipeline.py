@@ -41,7 +41,6 @@ log = logging.getLogger(__name__)
 #: ``extra`` of the records the command line reports itself, in one line (log file only).
 FILE_ONLY = {"file_only": True}
 PROGRESS_BAR_S = 0.5
-PROGRESS_LOG_S = 30.0
 
 
 def run_scenario(
@@ -272,6 +271,13 @@ def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]
     return names
 
 
+def _terminal() -> bool:
+    """Whether stderr is a terminal (the progress bar draws there; else progress lines)."""
+    import sys
+
+    return bool(getattr(sys.stderr, "isatty", lambda: False)())
+
+
 def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifest, wall_start):
     """The mass balance, the recorders and the Simulation with every callback.
 
@@ -279,9 +285,9 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
     recorded at its step.
     """
     from floodsph.simulation.loop import Simulation
-    from floodsph.simulation.probes import MassBalance, Progress, log_progress
+    from floodsph.simulation.probes import MassBalance, Progress, ProgressLines
     from floodsph.simulation.recorders import Recorders
-    from floodsph.simulation.schedules import TimeInterval, WallTimeInterval
+    from floodsph.simulation.schedules import IterationInterval, TimeInterval, WallTimeInterval
 
     work = folder.work
     state = None if checkpoint is None else checkpoint.recorders
@@ -294,7 +300,8 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
         (mass, TimeInterval(scenario.output.mass_balance_interval_s)),
         *recorders.callbacks(),
         (bar, WallTimeInterval(PROGRESS_BAR_S)),
-        (log_progress, WallTimeInterval(PROGRESS_LOG_S)),
+        (ProgressLines(scenario.end_time_s, to_stderr=opts.progress and not _terminal()),
+         IterationInterval(1)),
         *opts.callbacks,
     ]
     interval = scenario.output.checkpoint_interval_s
