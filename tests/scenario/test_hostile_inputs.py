@@ -360,7 +360,9 @@ IMPOSSIBLE_NUMBERS = [
 
 # -- too large for memory: refused before anything is allocated ------------------------------
 
-@case("scenario.toml: the run needs an estimated", "seeding lattice", "particle_spacing_m")
+@case("scenario.toml: the run needs an estimated", "particle_spacing_m",
+      "at peak (seeding lattice 814.9 TB (while seeding: the peak), program and libraries "
+      "500.0 MB, map grids 75.0 kB, terrain grids 50.0 kB) but only")
 def spacing_too_fine_for_memory(folder):
     return replaced(("particle_spacing_m = 10.0", "particle_spacing_m = 1e-4"))
 
