@@ -232,6 +232,19 @@ def inflow_line_in_lonlat(folder):
             'hydrograph = "q.csv"\n')
 
 
+@case("gauges.csv: gauge file needs the columns id, x, y; found one column 'id;x;y': the "
+      "file is separated by semicolons; save it comma-separated")
+def gauges_separated_by_semicolons(folder):
+    (folder / "gauges.csv").write_text(f"id;x;y\nG1;{X0 + 50.0};{Y0 + 50.0}\n")
+    return BASE_SCENARIO + GAUGES
+
+
+@case("gauges.csv: gauge file needs the columns id, x, y; found the columns 'name', 'x', 'y'")
+def gauges_without_an_id_column(folder):
+    (folder / "gauges.csv").write_text(f"name,x,y\nG1,{X0 + 50.0},{Y0 + 50.0}\n")
+    return BASE_SCENARIO + GAUGES
+
+
 @case("gauges.csv, line 2: gauge 'G1'", "longitude/latitude")
 def gauge_in_lonlat(folder):
     (folder / "gauges.csv").write_text("id,x,y\nG1,9.01,45.02\n")
