@@ -8,15 +8,19 @@ end time and the CFL condition of the fastest water,
 (a dam break's front runs at about 2 sqrt(g d0), Ritter's solution), with h = kappa dx and
 d_max the deepest initial water or the critical depth (q^2 / g)^(1/3) of an inflow's peak
 unit discharge q = Q_peak / L. The particles lie between the initial count and the memory
-estimate's peak (``floodsph.inputs.memory``). The throughput is stated as a range,
+estimate's peak (``floodsph.inputs.memory``). With local time steps (the default) a particle
+is updated at its own step, a multiple of the finest: the updates are
+:data:`LOCAL_UPDATE_FRACTION` of the global-step count (measured 0.31 and 0.34 on Malpasset,
+0.45 on EA test 4, 0.72 on Ritter's dam break). The throughput is stated as a range,
 :data:`THROUGHPUT_PER_THREAD` particle-steps per second per thread (measured on the project
 machine: 0.6 million on the sample with the default settings, 1.7-2.5 million on two
 threads for a block of 100,000 particles, 0.14 million with ``refinement = "split"`` on
 Malpasset; ``docs/measurements.md``), with a parallel efficiency of
-:data:`PARALLEL_EFFICIENCY` per added thread. Local time steps make the lower end likelier.
+:data:`PARALLEL_EFFICIENCY` per added thread.
 
-On the sample (``data_samples/valley``, one thread) the range is 10-83 s (3,605 steps) for a
-run measured at 24.5 s (2,326 steps); on the conftest valley 50 steps for 34.
+On the sample (``data_samples/valley``, one thread) the range is 3-63 s (3,605 steps) for a
+run measured at 24.5 s (2,326 steps); on the conftest valley 50 steps for 34; on Malpasset
+(sea as particles) 2-43 min on one thread, where two threads took 250 s.
 """
 
 from __future__ import annotations
@@ -33,6 +37,8 @@ from floodsph.errors import warn
 THROUGHPUT_PER_THREAD = (0.25e6, 1.0e6)
 #: Each thread beyond the first adds this fraction of one.
 PARALLEL_EFFICIENCY = 0.7
+#: Particle updates with local time steps, as a fraction of particles x finest steps.
+LOCAL_UPDATE_FRACTION = (0.3, 0.75)
 #: Above this many particles at peak, ``check`` and ``run`` warn.
 HUGE_PARTICLES = 5_000_000
 #: A spacing below this fraction of the DEM cell is warned of: it resolves no more terrain.
@@ -70,7 +76,9 @@ def estimate_run_time(scenario, inputs, threads: int) -> RunTimeEstimate:
     steps = max(1, math.ceil(scenario.end_time_s / dt))
     particles = (max(inputs.particles.n, 1), max(inputs.memory.particles_peak,
                                                  inputs.particles.n, 1))
-    work = (steps * particles[0], steps * particles[1])
+    local = scenario.numerics.time_stepping.value == "local"
+    fraction = LOCAL_UPDATE_FRACTION if local else (1.0, 1.0)
+    work = (steps * particles[0] * fraction[0], steps * particles[1] * fraction[1])
     threads = max(1, int(threads))
     effective = 1.0 + PARALLEL_EFFICIENCY * (threads - 1)
     slow, fast = THROUGHPUT_PER_THREAD
