@@ -234,10 +234,12 @@ def run_tasks(client, tasks: list[MemberTask], on_result: Callable[[MemberResult
     bar = MemberProgress(len(tasks), progress)
     pending = as_completed(list(futures))
 
-    def collect(block: bool) -> None:
-        for future in pending.next_batch(block=block):
+    def collect() -> None:
+        for future in pending.next_batch(block=False):
             result = _result(future, futures[future])
-            if result.status not in ("completed", NOT_RUN):
+            if result.status == NOT_RUN:  # its turn came after the stop: recorded as not run
+                continue
+            if result.status != "completed":
                 log.warning("member %s %s: %s", result.id, result.status, result.error)
             on_result(result)
             bar.update(result)
@@ -250,10 +252,10 @@ def run_tasks(client, tasks: list[MemberTask], on_result: Callable[[MemberResult
                 Event(event_name, client=client).set()
                 deadline = time.monotonic() + STOP_GRACE_S
                 while not pending.is_empty() and time.monotonic() < deadline:
-                    collect(block=False)
+                    collect()
                     time.sleep(POLL_S)
                 raise RunInterrupted(f"interrupted by {stop.requested}")
-            collect(block=False)
+            collect()
             time.sleep(POLL_S)
     except BaseException:
         client.cancel(list(futures))
