@@ -29,8 +29,8 @@ import math
 import numpy as np
 
 from floodsph.boundaries.riemann import critical_depth, inflow_state
+from floodsph.checks.inflows import inward_normal
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.errors import InputError
 
 #: Buffer depth [m] below which the section holds no ghost particles.
 DEPTH_MIN_M = 1e-4
@@ -73,7 +73,9 @@ class Inflow:
     terrain : Terrain
         Used to choose the side of lower ground when ``direction`` is None.
     direction : (2,) array or None
-        Flow direction; only the side of the line it points to matters.
+        Flow direction; only the side of the line it points to matters
+        (:func:`floodsph.checks.inflows.inward_normal`, which refuses a direction parallel to
+        the line or pointing off the DEM).
     name : str
         Key path for error messages, e.g. ``"scenario.toml: inflows[0]"``.
     """
@@ -81,14 +83,12 @@ class Inflow:
     def __init__(self, line, hydrograph, spacing: float, kappa: float, terrain,
                  direction=None, name: str = "inflows[0]"):
         a, b = np.asarray(line, dtype=np.float64)
+        self.normal = inward_normal(a, b, terrain, direction, spacing, name)
         length = float(np.hypot(*(b - a)))
-        if not length > 0.0:
-            raise InputError(f"{name}.line: the two end points coincide (zero-length line)")
         self.name = name
         self.a = a
         self.length = length
         self.tangent = (b - a) / length
-        self.normal = self._inward_normal(terrain, direction, spacing)
         self.hydrograph = hydrograph
         self.q_peak = max(float(np.max(hydrograph.Q)) / length, 1e-6)
         self.count = max(1, int(round(length / spacing)))
@@ -110,32 +110,6 @@ class Inflow:
     def opening(self) -> np.ndarray:
         """The section as a (2, 2) array [A, B] (walls along it are cut open)."""
         return np.stack([self.a, self.a + self.length * self.tangent])
-
-    def _inward_normal(self, terrain, direction, spacing: float) -> np.ndarray:
-        normal = np.array([-self.tangent[1], self.tangent[0]])
-        if direction is not None:
-            side = float(np.dot(normal, np.asarray(direction, dtype=np.float64)))
-            if side == 0.0:
-                raise InputError(f"{self.name}.direction: {list(direction)} is parallel to the "
-                                 "line; give a direction across it")
-            return normal if side > 0.0 else -normal
-        mid = self.a + 0.5 * self.length * self.tangent
-        probe = max(2.0 * spacing, 2.0 * max(terrain.dx, terrain.dy))
-        level = [self._ground(terrain, mid + sign * probe * normal) for sign in (1.0, -1.0)]
-        if level[0] == level[1]:
-            raise InputError(f"{self.name}: the ground is level on both sides of the line; "
-                             "give direction = [dx, dy] to say where water enters")
-        return normal if level[0] < level[1] else -normal
-
-    @staticmethod
-    def _ground(terrain, point) -> float:
-        """Bed elevation at a local point; +inf off the DEM or on nodata (no water there)."""
-        col = int(math.floor(point[0] / terrain.dx))
-        row = int(math.floor(point[1] / terrain.dy))
-        ny, nx = terrain.shape
-        if not (0 <= col < nx and 0 <= row < ny) or not terrain.valid[row, col]:
-            return math.inf
-        return float(terrain.elevation[row, col])
 
     def _coordinates(self, x, y):
         """(s, tau): distance along the inward normal and along the line from A [m]."""

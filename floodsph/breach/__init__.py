@@ -26,7 +26,7 @@ formation_time_s         override t_f; default Froehlich (2008)
 start_time_s             breach initiation time on the hydrograph clock (default 0)
 duration_s               length of the hydrograph; default: until the outflow falls below
                          1e-4 of the peak after t_f (and after any inflow ends)
-dt_s                     RK4 step and output interval; default min(t_f/200, drainage time/20)
+dt_s                     output interval of the hydrograph; default min(t_f/200, drainage time/20)
 =======================  ==========================================================================
 
 The breach bottom starts at the lower of the dam crest (invert + h_b) and the initial level and

@@ -5,8 +5,9 @@ flood-practice.md §1.2), with H(V) the storage-elevation curve and Q_b the free
 weir flow through the breach (:func:`floodsph.breach.formulas.trapezoid_weir_discharge`).
 From initiation at ``start_time_s`` the breach grows over the formation time t_f by the fraction
 r(tau) (linear or sine progression): bottom width b = r B, bottom elevation
-z_b = z_top - r (z_top - z_invert), side slopes z constant. The equation is integrated with the
-classical fixed-step Runge-Kutta scheme (RK4); each step is also an output sample.
+z_b = z_top - r (z_top - z_invert), side slopes z constant. The equation is integrated with
+``scipy.integrate.solve_ivp`` (adaptive Dormand-Prince between the kinks of the right-hand side,
+an event for the end of the outflow), sampled every ``dt`` (:func:`route`).
 
 Volume check: the released volume is the exact integral of the piecewise-linear output
 hydrograph (what a model interpolating the CSV injects), and the initial storage plus inflow
@@ -55,12 +56,10 @@ class BreachSummary:
 
 
 def _auto_dt(setup: BreachSetup):
-    """Step: t_f / 200, and at most 1/20 of the drainage time scale of the full breach.
-
-    Drainage time scale tau = A / (dQ_b/dH) with the mean surface area A = stored / h_w and the
-    weir derivative at head h_w, so that the explicit scheme stays accurate (RK4 is stable for
-    dt < 2.8 tau).
-    """
+    """Sampling interval of the hydrograph: t_f / 200, and at most 1/20 of the drainage time
+    scale of the full breach, tau = A / (dQ_b/dH), with the mean surface area A = stored / h_w
+    and the weir derivative at head h_w, so that linear interpolation between samples follows
+    the outflow closely."""
     p = setup.params
     y = setup.head_m
     area = setup.volume_m3 / y
@@ -86,8 +85,22 @@ def _outflow_function(setup: BreachSetup):
     return outflow
 
 
+#: Relative tolerance of the adaptive integration (the absolute one scales with the storage).
+RTOL = 1e-9
+
+
 def route(setup: BreachSetup):
-    """Integrate the level-pool equation; return sample times [s], outflow [m3/s], final storage."""
+    """Integrate the level-pool equation; return sample times [s], outflow [m3/s], final storage.
+
+    ``scipy.integrate.solve_ivp`` (Dormand-Prince 5(4), adaptive, relative tolerance
+    :data:`RTOL`) integrates between the breakpoints of the right-hand side (breach initiation,
+    end of formation, end of the reservoir inflow), where it has kinks; the hydrograph is
+    sampled every ``dt`` from its dense output. Without ``duration_s`` the last piece ends
+    at the event "outflow falls to :data:`STOP_FRACTION` of the peak so far" (once the breach
+    has formed and the inflow ended the outflow only falls), which is the last sample.
+    """
+    from scipy.integrate import solve_ivp
+
     p = setup.params
     dt = p.dt_s if p.dt_s is not None else _auto_dt(setup)
     outflow = _outflow_function(setup)
@@ -96,27 +109,39 @@ def route(setup: BreachSetup):
     formed = p.start_time_s + setup.formation_time_s
     end = p.duration_s if p.duration_s is not None else (
         p.start_time_s + MAX_FORMATION_TIMES * setup.formation_time_s)
+    volume = setup.storage.volume(setup.initial_level_m)
+    atol = RTOL * max(abs(volume), 1.0)
 
-    def rate(t, volume):
-        return float(inflow(t)) - outflow(t, volume)
+    def rate(t, v):
+        return [float(inflow(t)) - outflow(t, v[0])]
 
-    t, volume = 0.0, setup.storage.volume(setup.initial_level_m)
-    times, flows = [t], [outflow(t, volume)]
-    peak = flows[0]
-    while t < end * (1.0 - 1e-12):
-        h = min(dt, end - t)
-        k1 = rate(t, volume)
-        k2 = rate(t + 0.5 * h, volume + 0.5 * h * k1)
-        k3 = rate(t + 0.5 * h, volume + 0.5 * h * k2)
-        k4 = rate(t + h, volume + h * k3)
-        volume += h * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0
-        t += h
-        q = outflow(t, volume)
-        times.append(t)
-        flows.append(q)
-        peak = max(peak, q)
-        if (p.duration_s is None and t >= formed and t >= inflow_end
-                and q < STOP_FRACTION * peak):
+    breaks = sorted({0.0, end, *(x for x in (p.start_time_s, formed, inflow_end) if 0 < x < end)})
+    grid = np.arange(0.0, end, dt)
+    times, flows = [0.0], [outflow(0.0, volume)]
+    for a, b in zip(breaks, breaks[1:], strict=False):
+        samples = grid[(grid > a) & (grid < b)]
+        samples = np.append(samples, b)
+        events = None
+        if p.duration_s is None and a >= max(formed, inflow_end):
+            threshold = STOP_FRACTION * max(flows)
+
+            def faded(t, v, threshold=threshold):
+                return outflow(t, v[0]) - threshold
+
+            faded.terminal, faded.direction = True, -1.0
+            events = faded
+        sol = solve_ivp(rate, (a, b), [volume], t_eval=samples, events=events, rtol=RTOL,
+                        atol=atol, max_step=max(b - a, dt))
+        if not sol.success:  # pragma: no cover - the right-hand side is smooth between breaks
+            raise RuntimeError(f"breach routing failed at t = {sol.t[-1]:g} s: {sol.message}")
+        ts, vs = list(sol.t), list(sol.y[0])
+        if events is not None and sol.t_events[0].size:
+            ts.append(float(sol.t_events[0][0]))
+            vs.append(float(sol.y_events[0][0][0]))
+        times += ts
+        flows += [outflow(t, v) for t, v in zip(ts, vs, strict=True)]
+        volume = vs[-1]
+        if sol.status == 1:  # the outflow has faded
             break
     return np.array(times), np.array(flows), volume
 

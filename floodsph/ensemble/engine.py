@@ -2,8 +2,13 @@
 
 Without ``--scheduler`` a ``dask.distributed.LocalCluster`` of worker *processes* is started,
 each with one dask thread (one member at a time) and ``NUMBA_NUM_THREADS`` = the threads per
-worker in its environment, so that workers x threads does not oversubscribe the cores. Its
-size comes from :func:`plan_workers`. With ``--scheduler ADDRESS`` the members go to an
+worker in its environment, so that workers x threads does not oversubscribe the cores (or the
+``NUMBA_NUM_THREADS`` the user set: :func:`thread_budget`). Its size comes from
+:func:`plan_workers`. The workers start with SIGINT, SIGTERM and SIGHUP ignored: a Ctrl-C at
+the terminal (sent to every process of the job) or a scheduler's SIGTERM is the main
+process's to handle, which records the ending and closes the cluster
+(``floodsph.ensemble.runner``); a worker does not die mid-member with a traceback of its
+own. With ``--scheduler ADDRESS`` the members go to an
 existing cluster (dask-jobqueue, dask-kubernetes, ``dask scheduler`` + ``dask worker``), whose
 workers must import floodsph and see the ensemble folder at the same path; start them with
 ``--nthreads 1`` (a worker thread per member) and ``NUMBA_NUM_THREADS`` set.
@@ -17,15 +22,24 @@ from __future__ import annotations
 
 import logging
 import os
+import threading
+import time
 import uuid
 from collections.abc import Callable
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+from floodsph.ensemble.manifest import NOT_RUN
 from floodsph.ensemble.members import MemberResult, MemberTask, run_member
 from floodsph.errors import InputError
 
 log = logging.getLogger(__name__)
+
+#: How often the main process looks for finished members and stop requests [s].
+POLL_S = 0.25
+#: How long running members get to write their checkpoint once the ensemble stops [s]
+#: (SLURM's default grace between SIGTERM and SIGKILL is 30 s).
+STOP_GRACE_S = 20.0
 
 INSTALL_HINT = ("floodsph ensemble needs dask.distributed, which is not installed; install it "
                 "with: pip install 'floodsph[ensemble]'")
@@ -62,6 +76,17 @@ def machine_cores() -> int:
     if hasattr(os, "sched_getaffinity"):
         return len(os.sched_getaffinity(0))
     return os.cpu_count() or 1
+
+
+def thread_budget() -> int:
+    """The numba threads the ensemble may share out: ``NUMBA_NUM_THREADS`` when the user set
+    it (also by ``floodsph --threads N``), else the machine's cores (:func:`machine_cores`)."""
+    value = os.environ.get("NUMBA_NUM_THREADS", "")
+    try:
+        told = int(value)
+    except ValueError:
+        told = 0
+    return told if told > 0 else machine_cores()
 
 
 @dataclass(frozen=True)
@@ -111,13 +136,38 @@ def open_client(plan: WorkerPlan, scheduler: str | None):
     import dask
 
     threads = str(plan.threads_per_worker)
-    with dask.config.set(CLUSTER_CONFIG):
+    with dask.config.set(CLUSTER_CONFIG), _stop_signals_ignored():
         cluster = LocalCluster(n_workers=plan.workers, threads_per_worker=1, processes=True,
                                host="127.0.0.1", dashboard_address=None,
                                silence_logs=logging.ERROR,
                                env={"NUMBA_NUM_THREADS": threads, "OMP_NUM_THREADS": threads})
     with cluster, Client(cluster) as client:
         yield client
+
+
+@contextmanager
+def _stop_signals_ignored():
+    """Ignore the stop signals while the worker processes are spawned: an ignored signal
+    stays ignored in a child, across exec (a handler does not), and Python keeps it so.
+
+    A stop signal sent to the main process in these few seconds (the cluster's start) is lost
+    with them: the ensemble goes on, and the signal must be sent again.
+    """
+    import signal
+
+    from floodsph.simulation.stop_signals import SIGNALS
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {sig: signal.getsignal(sig) for sig in SIGNALS}
+    for sig in SIGNALS:
+        signal.signal(sig, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def cluster_workers(client) -> int:
@@ -160,29 +210,59 @@ class MemberProgress:
 
 
 def run_tasks(client, tasks: list[MemberTask], on_result: Callable[[MemberResult], None],
-              progress: bool = True) -> None:
+              progress: bool = True, stop=None) -> None:
     """Run every task on the client's cluster; ``on_result`` gets each result as it comes.
 
-    On an interruption (Ctrl-C) the tasks not finished are cancelled before it propagates.
+    ``stop`` (a :class:`~floodsph.simulation.stop_signals.StopSignals`, armed here) is polled
+    every :data:`POLL_S`: once a stop is requested the running members are asked to stop
+    (a ``distributed.Event`` they poll: each writes its checkpoint and ends
+    ``interrupted``), their results are awaited for up to :data:`STOP_GRACE_S`, the members
+    not started are cancelled, and :class:`~floodsph.simulation.stop_signals.RunInterrupted`
+    is raised. On any other interruption the tasks not finished are cancelled before it
+    propagates.
     """
-    from distributed import as_completed
+    from distributed import Event, as_completed
 
+    from floodsph.simulation.stop_signals import RunInterrupted
+
+    event_name = f"floodsph-stop-{uuid.uuid4().hex}"
     futures = {}
     for task in tasks:
+        task = replace(task, stop_event=event_name)
         future = client.submit(run_member, task, key=f"floodsph-{task.id}-{uuid.uuid4().hex}")
         futures[future] = task
     bar = MemberProgress(len(tasks), progress)
-    try:
-        for future in as_completed(list(futures)):
+    pending = as_completed(list(futures))
+
+    def collect() -> None:
+        for future in pending.next_batch(block=False):
             result = _result(future, futures[future])
+            if result.status == NOT_RUN:  # its turn came after the stop: recorded as not run
+                continue
             if result.status != "completed":
                 log.warning("member %s %s: %s", result.id, result.status, result.error)
             on_result(result)
             bar.update(result)
+
+    try:
+        if stop is not None:
+            stop.armed = True
+        while not pending.is_empty():
+            if stop is not None and stop():
+                Event(event_name, client=client).set()
+                deadline = time.monotonic() + STOP_GRACE_S
+                while not pending.is_empty() and time.monotonic() < deadline:
+                    collect()
+                    time.sleep(POLL_S)
+                raise RunInterrupted(f"interrupted by {stop.requested}")
+            collect()
+            time.sleep(POLL_S)
     except BaseException:
         client.cancel(list(futures))
         raise
     finally:
+        if stop is not None:
+            stop.armed = False
         bar.close()
 
 

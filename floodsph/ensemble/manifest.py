@@ -4,7 +4,8 @@
 (the resolved ensemble file), ``status``, ``members``, ``members_completed``,
 ``members_failed``, ``scheduler`` (its address, or ``"local"``), ``workers``,
 ``wall_time_s``; and in addition ``error`` (why an ensemble failed), ``threads_per_worker``,
-``members_kept`` (completed members that ``--resume`` did not run again), ``started`` /
+``members_kept`` (completed members that ``--resume`` did not run again),
+``members_interrupted`` (running when the ensemble was interrupted), ``started`` /
 ``finished`` (ISO 8601, UTC), ``maps`` and ``pictures`` (the files written).
 
 ``status`` is ``"running"`` while the members run, then ``"completed"`` (every member
@@ -12,8 +13,9 @@ completed), ``"completed_with_failures"`` (some failed; the maps are over the co
 ones), ``"interrupted"`` or ``"failed"`` (no member completed, or the ensemble itself failed).
 
 ``samples.csv`` columns: ``member``, one per parameter key (the drawn value: for a
-``mode = "factor"`` parameter the factor), ``status`` (a member's run status, or
-``"not run"``), ``wall_time_s``, ``error``.
+``mode = "factor"`` parameter the factor), ``status`` (a member's run status --
+``interrupted`` for one running when the ensemble was interrupted -- or ``"not run"``),
+``wall_time_s``, ``error``.
 
 Both files are written atomically (``floodsph.run.atomic_files``), readable by the group.
 """
@@ -44,6 +46,7 @@ def new_manifest(ensemble: dict, members: int, scheduler: str | None) -> dict:
         "members": members,
         "members_completed": 0,
         "members_failed": 0,
+        "members_interrupted": 0,
         "members_kept": 0,
         "scheduler": scheduler or "local",
         "workers": None,
@@ -63,16 +66,13 @@ def final_status(completed: int, failed: int) -> str:
     return "completed_with_failures" if failed else "completed"
 
 
-def _atomic_write(path: Path, text: str) -> Path:
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8", newline="")
-    return path
-
-
 def write_manifest(folder: Path, manifest: dict) -> Path:
     """Write ``folder/ensemble.json``."""
-    return _atomic_write(Path(folder) / ENSEMBLE_JSON,
-                         json.dumps(json_safe(manifest), indent=2, allow_nan=False) + "\n")
+    path = Path(folder) / ENSEMBLE_JSON
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(json_safe(manifest), indent=2, allow_nan=False) + "\n",
+                       encoding="utf-8")
+    return path
 
 
 def read_manifest(folder: Path) -> dict | None:
@@ -105,4 +105,7 @@ def write_samples(folder: Path, keys, ids, rows, results: dict) -> Path:
         wall = None if result is None else result.wall_time_s
         error = None if result is None else result.error
         writer.writerow([mid, *(_cell(v) for v in drawn), status, _cell(wall), _cell(error)])
-    return _atomic_write(Path(folder) / SAMPLES_CSV, buffer.getvalue())
+    path = Path(folder) / SAMPLES_CSV
+    with atomic_path(path) as tmp:
+        tmp.write_text(buffer.getvalue(), encoding="utf-8", newline="")
+    return path

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from floodsph.ensemble.keys import MISSING, KeyPath, KeyPathError, assign, base_value, lookup
+from floodsph.ensemble.manifest import NOT_RUN
 from floodsph.ensemble.rasters import RASTER_KEYS, raster_name
 from floodsph.ensemble.sampling import Samples
 from floodsph.ensemble.spec import EnsembleSpec, Mode, Parameter
@@ -266,15 +267,21 @@ def _plain_json(value):
     return json.loads(json.dumps(value, sort_keys=True, default=str))
 
 
+#: How often a running member asks whether the ensemble is stopping [s of wall time].
+STOP_POLL_S = 1.0
+
+
 @dataclass(frozen=True)
 class MemberTask:
-    """What a worker needs to run one member: its folder, numba threads and whether a
-    completed run there may be replaced."""
+    """What a worker needs to run one member: its folder, numba threads, whether a completed
+    run there may be replaced, and the name of the ``distributed.Event`` that is set when the
+    ensemble stops (None: not asked)."""
 
     id: str
     folder: str
     threads: int
     overwrite: bool
+    stop_event: str | None = None
 
 
 @dataclass(frozen=True)
@@ -295,11 +302,35 @@ def run_member(task: MemberTask) -> MemberResult:
 
     start = time.monotonic()
     folder = Path(task.folder)
+    stopping = _stop_request(task.stop_event)
+    if stopping is not None and stopping(poll=True):
+        return MemberResult(task.id, NOT_RUN, None)  # the ensemble stopped before its turn
     try:
         scenario = load_scenario(folder / SCENARIO_NAME)
         manifest = run_scenario(scenario, out_dir=folder, progress=False,
-                                overwrite=task.overwrite, threads=task.threads)
+                                overwrite=task.overwrite, threads=task.threads,
+                                stop_requested=stopping)
     except Exception as exc:  # recorded as the member's failure; the ensemble goes on
         return MemberResult(task.id, "failed", time.monotonic() - start, error_message(exc))
     return MemberResult(task.id, manifest["status"], manifest.get("wall_time_s"),
                         manifest.get("error"))
+
+
+def _stop_request(event_name: str | None):
+    """``stop_requested()`` for :func:`floodsph.run.pipeline.run_scenario`: the reason once
+    the ensemble's ``distributed.Event`` is set, asked at most every :data:`STOP_POLL_S`."""
+    if event_name is None:
+        return None
+    from distributed import Event
+
+    event = Event(event_name)
+    last = [-STOP_POLL_S]
+
+    def requested(poll: bool = False) -> str | None:
+        now = time.monotonic()
+        if not poll and now - last[0] < STOP_POLL_S:
+            return None
+        last[0] = now
+        return "the ensemble's stop request" if event.is_set() else None
+
+    return requested

@@ -25,12 +25,12 @@ Global attributes add the resolved ensemble (JSON) and the number of completed m
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 
 from floodsph.ensemble.aggregate import UK_CLASSES, EnsembleMaps
+from floodsph.run.atomic_files import atomic_path
 
 #: variable -> (dimension, long name, units)
 VARIABLES = {
@@ -89,7 +89,6 @@ def write_ensemble_netcdf(path, maps: EnsembleMaps, grid, *, ensemble: dict,
     attrs["ensemble"] = json.dumps(ensemble, sort_keys=True)
     attrs["members_completed"] = int(maps.members)
     ds = xr.Dataset(data_vars, coords=coords, attrs=attrs)
-    part = path.with_name(path.name + ".part")
-    ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
-    os.replace(part, path)
+    with atomic_path(path) as part:
+        ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
     return path

@@ -9,12 +9,12 @@ float64.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 
 from floodsph.errors import InputError
+from floodsph.run.atomic_files import atomic_path
 
 #: Key patterns whose value may be a raster file that a factor scales.
 RASTER_KEYS = ("terrain.manning", "initial_water[].depth")
@@ -42,8 +42,7 @@ def scale_raster(source: Path, target: Path, factor: float, where: str) -> Path:
     dtype = np.float64 if data.dtype == np.float64 else np.float32
     scaled = np.ma.filled(data.astype(dtype) * dtype(factor),
                           np.nan if nodata is None else nodata)
-    part = target.with_name(target.name + ".part")
-    with rasterio.open(part, "w", dtype=scaled.dtype, nodata=nodata, **profile) as dst:
+    with (atomic_path(target) as part,
+          rasterio.open(part, "w", dtype=scaled.dtype, nodata=nodata, **profile) as dst):
         dst.write(scaled, 1)
-    os.replace(part, target)
     return target

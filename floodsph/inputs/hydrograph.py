@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import csv
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,6 +22,7 @@ import numpy as np
 
 from floodsph.errors import InputError
 from floodsph.io.text import read_csv_rows
+from floodsph.run.atomic_files import atomic_path
 from floodsph.scenario.schema import LARGEST_VALUE
 
 TIME_COLUMN = "time_s"
@@ -218,9 +218,8 @@ def write_hydrograph_csv(path, t, Q):
     if t.ndim != 1 or t.shape != Q.shape or t.size < 2:
         raise ValueError("t and Q must be 1-D arrays of the same length >= 2")
     path = Path(path)
-    partial = path.with_name(path.name + ".partial")
-    with open(partial, "w", newline="", encoding="utf-8") as stream:
+    with atomic_path(path) as partial, open(partial, "w", newline="",
+                                            encoding="utf-8") as stream:
         writer = csv.writer(stream)
         writer.writerow([TIME_COLUMN, DISCHARGE_COLUMN])
         writer.writerows((repr(float(a)), repr(float(b))) for a, b in zip(t, Q, strict=True))
-    os.replace(partial, path)

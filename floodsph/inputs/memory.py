@@ -31,9 +31,14 @@ Bytes, at the larger of the two peaks (seeding, then the run)::
   neighbours x 8 B (240 B): 640 B;
 * OUTPUT = cells_out * 12 * 8: ~12 float64 envelope maps (max depth, speed, ..., arrival,
   duration);
-* ``BASE_BYTES`` = 350 MB: the interpreter with numpy, numba, rasterio and xarray imported
-  (153 MiB resident on the project machine, 183 MiB with floodsph imported: VmRSS) plus
-  compiled kernels.
+* ``BASE_BYTES`` = 500 MiB: the interpreter with numpy, numba, rasterio, xarray, netCDF4 and
+  matplotlib imported and the kernels loaded or compiled. Measured peak resident memory
+  (``getrusage`` ``ru_maxrss``) of a whole run of a 200-particle valley, where the base is
+  all there is: 418 MiB with the kernels in numba's cache, 649 MiB when they compile (LLVM's
+  working memory: the first run after an install). 500 MiB is within 25 % of both. On the
+  sample (``data_samples/valley``, 9,300 particles at peak, cached kernels) the estimate is
+  514 MiB against a peak of 454 MiB (+13 %); on Malpasset (``workflows/malpasset``, the sea
+  as particles, 17,900 at peak, one thread) 581 MiB against 612 MiB (-5 %; it was -30 %).
 
 Every count comes from shapes and areas known before the arrays exist (``floodsph.inputs.prepare``
 estimates before reading the DEM, and again before seeding), so a run too large is refused
@@ -52,7 +57,7 @@ BYTES_PER_PARTICLE = 2 * 13 * 8 + 24 * 8 + 30 * 8
 OUTPUT_MAPS = 12
 DEM_GRIDS = 8
 SEEDING_ARRAYS = 14
-BASE_BYTES = 350 * 2**20
+BASE_BYTES = 500 * 2**20
 COUNT_LIMIT = 1.0e24
 
 #: Environment variable that overrides the available memory [bytes] (used by tests).
@@ -76,11 +81,26 @@ class MemoryEstimate:
         return self.base_bytes + self.dem_bytes + max(self.seeding_bytes, running)
 
     def parts_text(self) -> str:
-        """``'particles 1.2 GB, ...'``: the parts of the estimate, for messages."""
-        return (f"particles {format_bytes(self.particle_bytes)} ({self.particles_peak} at peak), "
-                f"seeding lattice {format_bytes(self.seeding_bytes)}, "
-                f"terrain grids {format_bytes(self.dem_bytes)}, "
-                f"map grids {format_bytes(self.output_bytes)}")
+        """``'seeding lattice 46.9 GB (while seeding), terrain grids 1.2 GB, ...'``: the
+        parts of the estimate, largest first, for messages.
+
+        The two phases are told apart (the seeding lattice is freed before the particles and
+        maps are allocated: the peak is the larger of the two), and particles appear once
+        they are counted (not in the estimate made before the initial water is known, whose
+        only particles are the inflows').
+        """
+        seeding = self.seeding_bytes >= self.particle_bytes + self.output_bytes
+        parts = [(self.seeding_bytes,
+                  f"seeding lattice {format_bytes(self.seeding_bytes)}"
+                  + (" (while seeding: the peak)" if seeding else " (while seeding)")),
+                 (self.dem_bytes, f"terrain grids {format_bytes(self.dem_bytes)}"),
+                 (self.output_bytes, f"map grids {format_bytes(self.output_bytes)}"),
+                 (self.base_bytes, f"program and libraries {format_bytes(self.base_bytes)}")]
+        if self.particles_peak > 1:
+            parts.append((self.particle_bytes,
+                          f"particles {format_bytes(self.particle_bytes)} "
+                          f"({self.particles_peak:,} at peak)"))
+        return ", ".join(text for size, text in sorted(parts, key=lambda p: -p[0]) if size)
 
 
 def _count(x: float) -> int:

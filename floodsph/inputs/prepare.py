@@ -13,12 +13,14 @@ created (``floodsph check`` stops after it and prints :func:`summary_lines`):
    (``floodsph.checks.placement``);
 5. build the initial depth grid: the deepest of all ``[[initial_water]]`` bodies per cell
    (two overlapping still-water bodies hold the higher level, not the sum); refuse a
-   scenario without water (``floodsph.checks.water``);
+   scenario without water (``floodsph.checks.water``) and an inflow without a side to enter
+   on (``floodsph.checks.inflows``);
 6. estimate the memory again from the wet area (particles = wet area / spacing^2) and
    refuse before seeding; seed particles on the lattice of spacing
    ``numerics.particle_spacing_m`` (default: the DEM cell size);
 7. read the gauge points (they must lie on the DEM);
-8. the final memory estimate from the particle count.
+8. the final memory estimate from the particle count; a warning above 5 million particles at
+   peak or for a spacing finer than a quarter of the DEM cell (``floodsph.inputs.run_time``).
 
 Problems the user may mean are warnings: logged, and kept in :attr:`Inputs.warnings` (the run
 records them in ``run.json``).
@@ -31,10 +33,12 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.checks.inflows import check_inflows
 from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
 from floodsph.inputs.memory import MemoryEstimate, check_memory, estimate_memory, format_bytes
+from floodsph.inputs.run_time import estimate_run_time, run_threads, warn_if_huge
 from floodsph.inputs.vectors import vector_gauges, with_vector_geometry
 from floodsph.io.raster import crs_label
 from floodsph.io.vector import is_vector_file
@@ -96,6 +100,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     dry: list[str] = []
     depth = initial_depth(scenario, terrain, wet, dry)
     check_has_water(scenario, dry, bool(np.any(depth > 0.0)), v_in, source, warnings)
+    check_inflows(scenario, terrain, depth, spacing, source, warnings)
     out_cells = output_cells(scenario, terrain.shape, terrain.dx, terrain.dy)
     n_wet = np.count_nonzero(depth > 0.0) * terrain.dx * terrain.dy / spacing / spacing
     lattice = lattice_cells(terrain.width, terrain.height, spacing)
@@ -118,6 +123,8 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     memory = _estimate(scenario, particles.n, v_in, spacing, terrain.elevation.size, out_cells,
                        lattice, read)
     check_memory(memory, source)
+    warn_if_huge(scenario, spacing, float(min(terrain.dx, terrain.dy)), memory.particles_peak,
+                 source, warnings)
     walls = [local_points(terrain, w.polyline) for w in scenario.walls]
     return Inputs(
         terrain=terrain,
@@ -249,7 +256,7 @@ def inflow_hydrographs(scenario: Scenario) -> list:
 
 
 def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> list[str]:
-    """The ``floodsph check`` report: domain, CRS, volumes, particles, memory."""
+    """The ``floodsph check`` report: domain, CRS, volumes, particles, memory, run time."""
     t = inputs.terrain
     ny, nx = t.shape
     valid = int(np.count_nonzero(t.valid))
@@ -272,7 +279,8 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"Particles:       {inputs.particles.n}",
         f"Spacing:         {inputs.spacing_m:g} m "
         f"(h0 = {scenario.numerics.kappa * inputs.spacing_m:g} m)",
-        f"Peak memory:     ~{format_bytes(mem.total)} (estimate, {mem.particles_peak} particles "
-        f"at peak); available {avail}",
+        f"Peak memory:     ~{format_bytes(mem.total)} (estimate, {mem.particles_peak:,} "
+        f"particles at peak); available {avail}",
+        f"Run time:        {estimate_run_time(scenario, inputs, run_threads(scenario)).text()}",
         f"Warnings:        {len(inputs.warnings)}",
     ]

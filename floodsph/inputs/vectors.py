@@ -6,10 +6,10 @@ per part of each feature, with its coordinates in the DEM's CRS, checked as inli
 messages:
 
 * walls: each line (LineString, and each part of a MultiLineString) is a wall, each polygon's
-  outline a closed wall (a solid footprint);
-* initial water and sinks: each polygon (and each part of a MultiPolygon) is one area; a
-  polygon with holes is refused (draw the island as its own body, or leave it: ground above
-  the level stays dry anyway).
+  outline a closed wall (a solid footprint), and each of its holes another (a courtyard);
+* initial water and sinks: each polygon (and each part of a MultiPolygon) is one area; its
+  holes (islands in a reservoir) stay outside it: the polygon becomes one ring with a bridge
+  to each hole (:func:`keyhole_ring`).
 
 A feature of another geometry type, or a file without features, is refused naming the file.
 ``[gauges]`` points come from :func:`vector_gauges`.
@@ -71,23 +71,49 @@ def _parts(entry, where: str, terrain, types: tuple[str, ...]):
             raise InputError(f"{where}: feature {k} is {kind or 'empty'}; expected "
                              f"{' or '.join(types)} here")
         for part in shapely.get_parts(geometry):
-            if part.geom_type == "Polygon":
-                if len(part.interiors):
-                    raise InputError(f"{where}: feature {k} is a polygon with "
-                                     f"{len(part.interiors)} hole(s); give its outline only "
-                                     "(ground above the level stays dry anyway)")
-                points = _points(part.exterior.coords)
-                problem = (polyline_problem(points) if "LineString" in types
-                           else polygon_problem(points))
+            if part.geom_type == "Polygon" and "LineString" in types:  # walls round each ring
+                rings = [_points(r.coords) for r in (part.exterior, *part.interiors)]
+                checks = [polyline_problem(r) for r in rings]
+            elif part.geom_type == "Polygon":
+                rings = [keyhole_ring(part)]
+                checks = [polygon_problem(rings[0])]
             else:
-                points = _points(part.coords)
-                problem = polyline_problem(points)
-            if problem is not None:
-                raise InputError(f"{where}: feature {k}: {problem}")
-            out.append((label, points))
+                rings = [_points(part.coords)]
+                checks = [polyline_problem(rings[0])]
+            for points, problem in zip(rings, checks, strict=True):
+                if problem is not None:
+                    raise InputError(f"{where}: feature {k}: {problem}")
+                out.append((label, points))
     if not out:
         raise InputError(f"{where}: holds no features")
     return out
+
+
+def keyhole_ring(polygon) -> tuple[tuple[float, float], ...]:
+    """One ring of a shapely polygon with holes: the outline, and at the outline's vertex
+    nearest to each hole a bridge in to the hole's nearest vertex, round the hole and back.
+
+    By the even-odd rule the holes are outside the ring (the bridge edges, run twice, cancel),
+    which is how the initial water and the sinks fill a polygon
+    (:func:`floodsph.io.polygons.points_in_polygon`). A bridge that crosses another hole
+    makes the ring cross itself, which :func:`floodsph.checks.shapes.polygon_problem` refuses.
+    """
+    outline = list(_points(polygon.exterior.coords))[:-1]
+    detours: dict[int, list] = {}
+    for hole in polygon.interiors:
+        ring = np.asarray(_points(hole.coords)[:-1])
+        edge = np.asarray(outline)
+        gaps = np.hypot(edge[:, None, 0] - ring[None, :, 0], edge[:, None, 1] - ring[None, :, 1])
+        at, into = np.unravel_index(int(np.argmin(gaps)), gaps.shape)
+        loop = [tuple(p) for p in np.roll(ring, -into, axis=0)]
+        detours.setdefault(int(at), []).append([*loop, loop[0], outline[at]])
+    points = []
+    for i, vertex in enumerate(outline):
+        points.append(vertex)
+        for detour in detours.get(i, []):
+            points.extend(detour)
+    points.append(outline[0])
+    return tuple((float(x), float(y)) for x, y in points)
 
 
 def _points(coords) -> tuple[tuple[float, float], ...]:

@@ -47,3 +47,25 @@ def read_csv_rows(path, where: str) -> list[list[str]]:
         return list(csv.reader(io.StringIO(read_text(path, where), newline="")))
     except csv.Error as exc:
         raise InputError(f"{where}: cannot be read as CSV ({exc})") from None
+
+
+#: Separators other than the comma that spreadsheets write (a ';' where the decimal mark is a
+#: comma, as in most of Europe), and their names for messages.
+OTHER_SEPARATORS = {";": "semicolons", "\t": "tabs", "|": "vertical bars"}
+
+
+def header_found(text: str) -> str:
+    """What the first line of a CSV text holds, for the message of a missing column:
+    ``found the columns 'id', 'east', 'north'``, or, when the line is one column split by
+    another separator, ``found one column 'id;x;y': the file is separated by semicolons;
+    save it comma-separated``."""
+    first = next(iter(text.splitlines()), "")
+    if not first.strip():
+        return "found an empty first line"
+    columns = next(csv.reader([first]))
+    if len(columns) == 1:
+        for sep, name in OTHER_SEPARATORS.items():
+            if sep in first:
+                return (f"found one column {first!r}: the file is separated by {name}; save "
+                        "it comma-separated (in Excel: \"CSV UTF-8 (Comma delimited)\")")
+    return "found the columns " + ", ".join(repr(c) for c in columns)

@@ -1,10 +1,11 @@
 """Vector files of the scenario's geometry (walls, initial water, sinks, gauges), in any CRS.
 
-* GeoJSON (``.geojson``, ``.json``) is read with the standard library and shapely: RFC 7946
-  coordinates are longitude/latitude on WGS 84 (``OGC:CRS84``), unless the file names another
-  CRS in the ``crs`` member of the 2008 GeoJSON specification;
-* GeoPackage (``.gpkg``), shapefile (``.shp``) and FlatGeobuf (``.fgb``) are read through
-  pyogrio (GDAL/OGR), the optional extra ``floodsph[gis]``; their CRS is the layer's.
+Every format is read through pyogrio (GDAL/OGR), which knows the format from the file
+itself: GeoJSON, GeoPackage, shapefiles (also zipped: ``walls.zip``, ``walls.shp.zip``),
+FlatGeobuf, KML, GML and the other vector formats of GDAL's drivers, each with the CRS it
+carries (a shapefile's ``.prj``; GeoJSON's RFC 7946 longitude/latitude on WGS 84 unless the
+file names another CRS in its 2008-style ``crs`` member; KML's WGS 84). A file whose name
+ends in ``.csv``, ``.tsv`` or ``.txt`` is a table, not a vector file (a gauge CSV).
 
 The ``crs`` key of the scenario entry gives the CRS of a file that carries none (a shapefile
 without its ``.prj``) or overrides the file's. :func:`read_vector` returns the features in
@@ -15,22 +16,20 @@ key, through ``where``).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
 from floodsph.errors import InputError
 
-GEOJSON_SUFFIXES = (".geojson", ".json")
-OGR_SUFFIXES = (".gpkg", ".shp", ".fgb")
-VECTOR_SUFFIXES = GEOJSON_SUFFIXES + OGR_SUFFIXES
-GEOJSON_CRS = "OGC:CRS84"
-"""The CRS of RFC 7946 GeoJSON: WGS 84 longitude, latitude [degrees]."""
+TABLE_SUFFIXES = (".csv", ".tsv", ".txt")
+"""Names of text tables: a ``[gauges]`` file so named is the ``id,x,y`` CSV."""
+VECTOR_FORMATS = "GeoJSON, GeoPackage, shapefile (or a zipped one), FlatGeobuf, KML, GML"
+"""The usual vector formats, for messages (GDAL reads more)."""
 
 
 def is_vector_file(path) -> bool:
-    """True for a file name ending in one of :data:`VECTOR_SUFFIXES` (any case)."""
-    return Path(path).suffix.lower() in VECTOR_SUFFIXES
+    """True for a file that is not a text table (:data:`TABLE_SUFFIXES`, any case)."""
+    return Path(path).suffix.lower() not in TABLE_SUFFIXES
 
 
 @dataclass(frozen=True)
@@ -49,68 +48,16 @@ def read_vector(path, where: str, target_crs_wkt: str | None, *, layer: str | No
     ``where`` starts every message (``"scenario.toml: walls[0].file walls.gpkg"``). ``crs``
     is the CRS of the coordinates when the file has none, or instead of its own.
     """
-    path = Path(path)
-    if path.suffix.lower() in GEOJSON_SUFFIXES:
-        if layer is not None:
-            raise InputError(f"{where}: a GeoJSON file holds one layer; remove layer")
-        geometries, properties, own = _read_geojson(path, where)
-    else:
-        geometries, properties, own = _read_ogr(path, where, layer)
+    geometries, properties, own = _read(Path(path), where, layer)
     source_crs = crs if crs is not None else own
     return Features(_reproject(geometries, source_crs, target_crs_wkt, where), properties)
 
 
-def _read_geojson(path: Path, where: str):
-    """Geometries, properties and CRS of a GeoJSON FeatureCollection, Feature or geometry."""
-    import shapely.geometry
-
-    try:
-        data = json.loads(path.read_text(encoding="utf-8-sig"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{where}: cannot be read as GeoJSON ({exc})") from None
-    kind = data.get("type") if isinstance(data, dict) else None
-    if kind == "FeatureCollection":
-        features = data.get("features", [])
-    elif kind == "Feature":
-        features = [data]
-    elif kind is not None:
-        features = [{"type": "Feature", "geometry": data, "properties": {}}]
-    else:
-        raise InputError(f"{where}: not GeoJSON (no \"type\" member at the top)")
-    geometries, properties = [], []
-    for k, feature in enumerate(features, start=1):
-        try:
-            geometry = feature.get("geometry")
-            geometries.append(None if geometry is None else shapely.geometry.shape(geometry))
-        except (AttributeError, KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"{where}: feature {k}: not a GeoJSON geometry ({exc})") from None
-        properties.append(dict(feature.get("properties") or {}))
-    return geometries, properties, _geojson_crs(data, where)
-
-
-def _geojson_crs(data: dict, where: str) -> str:
-    """The named CRS of a 2008 GeoJSON ``crs`` member, else RFC 7946's WGS 84 lon/lat."""
-    member = data.get("crs")
-    if member is None:
-        return GEOJSON_CRS
-    try:
-        return str(member["properties"]["name"])
-    except (KeyError, TypeError):
-        raise InputError(f"{where}: its \"crs\" member names no CRS "
-                         "(expected {\"type\": \"name\", \"properties\": {\"name\": ...}})"
-                         ) from None
-
-
-def _read_ogr(path: Path, where: str, layer: str | None):
+def _read(path: Path, where: str, layer: str | None):
     """Geometries, properties and CRS (None if it has none) of one layer, through pyogrio."""
-    try:
-        import pyogrio
-        import pyogrio.errors
-        import pyogrio.raw
-    except ImportError:
-        raise InputError(f"{where}: reading {path.suffix} files needs pyogrio: "
-                         "pip install 'floodsph[gis]' (or convert the file to GeoJSON)"
-                         ) from None
+    import pyogrio
+    import pyogrio.errors
+    import pyogrio.raw
     import shapely
 
     try:
@@ -122,7 +69,8 @@ def _read_ogr(path: Path, where: str, layer: str | None):
                              "layer")
         meta, _, wkb, fields = pyogrio.raw.read(path, layer=layer)
     except (pyogrio.errors.DataSourceError, pyogrio.errors.DataLayerError) as exc:
-        raise InputError(f"{where}: cannot be read ({exc})") from None
+        raise InputError(f"{where}: cannot be read as a vector file ({VECTOR_FORMATS}): "
+                         f"{exc}") from None
     geometries = [None if g is None else shapely.from_wkb(g) for g in wkb]
     names = [str(n) for n in meta["fields"]]
     properties = [{n: column[k] for n, column in zip(names, fields, strict=True)}

@@ -19,7 +19,7 @@ import numpy as np
 
 from floodsph.checks.placement import extent_text, lonlat_hint
 from floodsph.errors import InputError
-from floodsph.io.text import read_text
+from floodsph.io.text import header_found, read_text
 from floodsph.output.grid import bilinear
 
 HEADER = ("time_s", "id", "depth_m", "level_m", "speed_ms")
@@ -50,7 +50,8 @@ def read_gauge_file(path, terrain) -> GaugePoints:
     with io.StringIO(text, newline="") as f:
         rows = list(csv.DictReader(f))
     if not rows or not {"id", "x", "y"} <= set(rows[0]):
-        raise InputError(f"{path}: gauge file needs the columns id, x, y")
+        raise InputError(f"{path}: gauge file needs the columns id, x, y; "
+                         f"{header_found(text)}")
     ids, xs, ys = [], [], []
     for line, row in enumerate(rows, start=2):
         try:

@@ -9,7 +9,9 @@ driver when this GDAL has it (GDAL >= 3.1), else a tiled GTiff whose overviews a
 with ``COPY_SRC_OVERVIEWS`` (the COG layout). Rows are flipped to north-up and the transform
 is the grid's world transform in the DEM CRS.
 
-Files are written to ``<name>.part`` and renamed, so a file of the final name is complete.
+Files are written under a temporary name and renamed
+(:func:`floodsph.run.atomic_files.atomic_path`),
+so a file of the final name is complete.
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ import os
 from pathlib import Path
 
 import numpy as np
+
+from floodsph.run.atomic_files import atomic_path
 
 BLOCK = 512
 
@@ -92,15 +96,15 @@ def write_north_up(path, array, crs, transform, name: str, units: str, *, long_n
     band_tags = {"units": units, "long_name": long_name or name}
     if class_names is not None:
         band_tags.update({f"class_{k}": str(n) for k, n in enumerate(class_names)})
-    part = path.with_name(path.name + ".part")
-    if (driver or ("COG" if _has_cog() else "GTiff")) == "COG":
-        cog = dict(profile, driver="COG", predictor="NO" if is_class else "FLOATING_POINT",
-                   overview_resampling="nearest" if is_class else "average")
-        with rasterio.open(part, "w", **cog) as dst:
-            _fill(dst, data, name, band_tags, tags, colours, ColorInterp)
-    else:
-        _write_gtiff_cog_layout(part, data, profile, name, band_tags, tags, colours, is_class)
-    os.replace(part, path)
+    with atomic_path(path) as part:
+        if (driver or ("COG" if _has_cog() else "GTiff")) == "COG":
+            cog = dict(profile, driver="COG", predictor="NO" if is_class else "FLOATING_POINT",
+                       overview_resampling="nearest" if is_class else "average")
+            with rasterio.open(part, "w", **cog) as dst:
+                _fill(dst, data, name, band_tags, tags, colours, ColorInterp)
+        else:
+            _write_gtiff_cog_layout(part, data, profile, name, band_tags, tags, colours,
+                                    is_class)
     return path
 
 

@@ -35,6 +35,7 @@ from floodsph.output.cf import (
     time_attrs,
     variable_attrs,
 )
+from floodsph.run.atomic_files import atomic_path
 
 
 def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
@@ -66,9 +67,8 @@ def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
         else:
             encoding[name] = {"_FillValue": np.float32(np.nan)}
         encoding[name].update(zlib=True, complevel=4, chunksizes=chunks)
-    part = path.with_name(path.name + ".part")
-    ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
-    os.replace(part, path)
+    with atomic_path(path) as part:
+        ds.to_netcdf(part, engine="netcdf4", format="NETCDF4", encoding=encoding)
     return path
 
 

@@ -11,16 +11,15 @@ Rules (``docs/run-folder.md``, the run-folder contract):
   replace it (``overwrite``) or to continue it (``resume``). A replacing run is written beside
   the old one, in ``.floodsph-new/``, and swapped in when it completes: an interrupted or
   failed replacement leaves the old maps as they were.
-* While a run writes a folder it holds an exclusive lock (``fcntl.flock`` on
-  ``.floodsph.lock``); the operating system releases it when the process ends, however it
-  ends, so a killed run never leaves a stale lock.
+* While a run writes a folder it holds an exclusive lock on ``.floodsph.lock`` (``filelock``:
+  ``flock`` on POSIX, ``msvcrt.locking`` on Windows); the operating system releases it when
+  the process ends, however it ends, so a killed run never leaves a stale lock.
 * Every file goes in under a temporary name and is renamed into place
   (``floodsph.run.atomic_files``); files are readable by the group, as the user's umask allows.
 """
 
 from __future__ import annotations
 
-import errno
 import os
 import shutil
 from collections.abc import Iterable
@@ -96,7 +95,7 @@ class RunFolder:
         self.overwrite = bool(overwrite)
         self.resume = bool(resume)
         self.staged = False
-        self._lock_fd: int | None = None
+        self._lock_file = None  # a filelock.FileLock while the folder is held
 
     # -- checks (nothing written) ------------------------------------------------------------
     def check(self) -> None:
@@ -230,27 +229,22 @@ class RunFolder:
         self.staged = False
 
     def _lock(self) -> None:
-        import fcntl
+        from filelock import FileLock, Timeout
 
-        fd = os.open(self.path / LOCK_NAME, os.O_RDWR | os.O_CREAT, 0o664)
+        lock = FileLock(self.path / LOCK_NAME, timeout=0, mode=0o664)
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as exc:
-            os.close(fd)
-            if exc.errno in (errno.EAGAIN, errno.EACCES):
-                raise InputError(f"{self.path}: another floodsph run is writing this folder "
-                                 "(it is locked); wait for it or choose another --output"
-                                 ) from None
-            raise
-        os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()}\n".encode())
-        self._lock_fd = fd
+            lock.acquire()
+        except Timeout:
+            raise InputError(f"{self.path}: another floodsph run is writing this folder "
+                             "(it is locked); wait for it or choose another --output"
+                             ) from None
+        self._lock_file = lock
 
     def close(self) -> None:
         """Release the lock (the lock file stays: removing it would race another run)."""
-        if self._lock_fd is not None:
-            os.close(self._lock_fd)
-            self._lock_fd = None
+        if self._lock_file is not None:
+            self._lock_file.release()
+            self._lock_file = None
 
 
 def _remove(entry: Path) -> None:

@@ -1,13 +1,14 @@
 """``run_scenario``: one scenario from its TOML to a finished run folder.
 
-The chain (architecture.md 3.2): the run folder is checked (``floodsph.run.folder``: nothing
-that is not a floodsph run's, no completed run unless replaced) -> inputs (terrain,
-particles, hydrographs; every input check happens here, before the run folder is touched)
--> the folder is locked and opened (``floodsph.log``, ``scenario.resolved.toml``,
-``run.json`` with status ``"running"``) -> ``FloodModel`` (or the one of a checkpoint) ->
-``Simulation`` with the mass-balance, progress, recorder and checkpoint callbacks -> maps,
-gauges and mass balance (written under temporary names, then renamed) -> quick-looks and
-``report.html`` (``floodsph.output.report``) -> ``run.json`` last.
+The chain (architecture.md 3.2): every test ``floodsph check`` makes, in the one function
+both call (``floodsph.run.preflight``: the run folder, with nothing that is not a floodsph
+run's and no completed run unless replaced; the inputs -- terrain, particles, hydrographs,
+inflow sides, memory -- all before the run folder is touched) -> the folder is locked and
+opened (``floodsph.log``, ``scenario.resolved.toml``, ``run.json`` with status
+``"running"``) -> ``FloodModel`` (or the one of a checkpoint) -> ``Simulation`` with the
+mass-balance, progress, recorder and checkpoint callbacks -> maps, gauges and mass balance
+(written under temporary names, then renamed) -> quick-looks and ``report.html``
+(``floodsph.output.report``) -> ``run.json`` last.
 
 ``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached
 before the end time); ``"interrupted"`` (SIGINT, SIGTERM or SIGHUP:
@@ -41,7 +42,6 @@ log = logging.getLogger(__name__)
 #: ``extra`` of the records the command line reports itself, in one line (log file only).
 FILE_ONLY = {"file_only": True}
 PROGRESS_BAR_S = 0.5
-PROGRESS_LOG_S = 30.0
 
 
 def run_scenario(
@@ -53,6 +53,7 @@ def run_scenario(
     threads: int | None = None,
     callbacks=(),
     resume: bool = False,
+    stop_requested=None,
 ) -> dict:
     """Run ``scenario`` and write its run folder; return the manifest (``run.json``).
 
@@ -76,26 +77,23 @@ def run_scenario(
     resume : bool
         Continue from the latest checkpoint in ``out_dir``; the scenario must equal the
         checkpointed one but for a later ``end_time_s``.
+    stop_requested : callable, optional
+        ``stop_requested() -> reason or None``, asked after every step: a reason ends the run
+        as a stop signal does (checkpoint, status ``"interrupted"``). An ensemble's member
+        on a dask worker is stopped this way.
 
     Raises
     ------
     InputError
         Bad input, a run folder the run may not write, or a run too large for the memory.
     """
-    from floodsph.inputs.memory import check_memory
-    from floodsph.inputs.prepare import prepare_inputs
+    from floodsph.run.preflight import preflight
 
-    if overwrite and resume:
-        raise InputError("--overwrite and --resume exclude each other: resume continues the "
-                         "run in the folder, overwrite replaces it")
-    out = Path(out_dir) if out_dir is not None else scenario.output_directory
-    folder = RunFolder(out, scenario.input_files(), overwrite=overwrite, resume=resume)
-    folder.check()
-    with StopSignals() as stop:
+    with StopSignals(external=stop_requested) as stop:
         used_threads = set_threads(scenario.numerics.threads if threads is None else threads)
-        inputs = prepare_inputs(scenario)
-        check_memory(inputs.memory, str(scenario.path.name))
-        checkpoint = _resumable(folder, scenario, inputs, used_threads) if resume else None
+        checked = preflight(scenario, out_dir, overwrite=overwrite, resume=resume,
+                            threads=used_threads)
+        inputs, folder, checkpoint = checked.inputs, checked.folder, checked.checkpoint
         work = folder.open()
         try:
             return _run(scenario, inputs, folder, work, checkpoint, stop,
@@ -112,27 +110,6 @@ class RunOptions:
     progress: bool
     threads: int
     callbacks: tuple
-
-
-def _resumable(folder: RunFolder, scenario: Scenario, inputs, threads: int):
-    """The checkpoint to resume from, refused unless the scenario is the same."""
-    from floodsph.simulation.checkpoint import load_checkpoint, scenario_difference
-
-    directory = folder.checkpoint_dir()
-    checkpoint = load_checkpoint(directory, inputs.terrain)
-    where = scenario_difference(checkpoint.scenario, scenario.to_dict())
-    if where is not None:
-        raise InputError(f"{scenario.path}: {where} differs from the checkpointed run's "
-                         f"({directory}); only scenario.end_time_s may change on --resume")
-    if checkpoint.t >= scenario.end_time_s - time_tolerance(scenario.end_time_s):
-        raise InputError(f"{scenario.path}: scenario.end_time_s = {scenario.end_time_s:g} s "
-                         f"is not after the checkpoint at t = {checkpoint.t:g} s; raise it "
-                         "to extend the run")
-    if checkpoint.threads != threads:
-        log.warning("the checkpoint was written with %d threads, this run has %d: the resumed "
-                    "run may differ from an uninterrupted one in the last digits",
-                    checkpoint.threads, threads)
-    return checkpoint
 
 
 def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
@@ -294,10 +271,16 @@ def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]
                                                  strict=True)):
         if inflow.breach is not None:
             name = f"breach_hydrograph_{i}.csv"
-            with atomic_path(out / name) as tmp:
-                write_hydrograph_csv(tmp, hydrograph.t, hydrograph.Q)
+            write_hydrograph_csv(out / name, hydrograph.t, hydrograph.Q)
             names.append(name)
     return names
+
+
+def _terminal() -> bool:
+    """Whether stderr is a terminal (the progress bar draws there; else progress lines)."""
+    import sys
+
+    return bool(getattr(sys.stderr, "isatty", lambda: False)())
 
 
 def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifest, wall_start):
@@ -307,9 +290,9 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
     recorded at its step.
     """
     from floodsph.simulation.loop import Simulation
-    from floodsph.simulation.probes import MassBalance, Progress, log_progress
+    from floodsph.simulation.probes import MassBalance, Progress, ProgressLines
     from floodsph.simulation.recorders import Recorders
-    from floodsph.simulation.schedules import TimeInterval, WallTimeInterval
+    from floodsph.simulation.schedules import IterationInterval, TimeInterval, WallTimeInterval
 
     work = folder.work
     state = None if checkpoint is None else checkpoint.recorders
@@ -322,7 +305,8 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
         (mass, TimeInterval(scenario.output.mass_balance_interval_s)),
         *recorders.callbacks(),
         (bar, WallTimeInterval(PROGRESS_BAR_S)),
-        (log_progress, WallTimeInterval(PROGRESS_LOG_S)),
+        (ProgressLines(scenario.end_time_s, to_stderr=opts.progress and not _terminal()),
+         IterationInterval(1)),
         *opts.callbacks,
     ]
     interval = scenario.output.checkpoint_interval_s

@@ -244,7 +244,7 @@ BREACH = TableDoc("inflows.breach", False, "A parametric dam breach (Froehlich 2
     KeyDoc("start_time_s", "number", "Breach initiation on the hydrograph's clock.", "s"),
     KeyDoc("duration_s", "number", "Length of the hydrograph.", "s",
            absent="until the outflow falls below 1e-4 of the peak after t_f"),
-    KeyDoc("dt_s", "number", "Step of the routing (RK4) and of the written hydrograph.", "s",
+    KeyDoc("dt_s", "number", "Sampling interval of the routed (and written) hydrograph.", "s",
            absent="min(t_f / 200, drainage time / 20)"),
 ))
 

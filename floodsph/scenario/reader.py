@@ -267,8 +267,8 @@ def _sink(r: Reader, t: dict, p: str) -> Sink:
 
 
 def _gauges(r: Reader, data: dict) -> Gauges | None:
-    """``[gauges]``: ``file`` is a CSV table, or a vector file (by its extension) with the
-    optional ``layer``, ``crs`` and ``id_field``."""
+    """``[gauges]``: ``file`` is a CSV table (``.csv``, ``.tsv``, ``.txt``), or a vector file
+    with the optional ``layer``, ``crs`` and ``id_field``."""
     from floodsph.io.vector import is_vector_file
 
     if "gauges" not in data:

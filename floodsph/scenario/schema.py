@@ -252,10 +252,10 @@ class Reader:
     def vector_source(self, table: dict, path: str, inline: str | None) -> dict:
         """``file`` (+ ``layer``, ``crs``): geometry from a vector file, as keyword arguments
         of the scenario entry (``{}`` without ``file``). ``inline`` names the key it replaces
-        (``polyline``, ``polygon``); both together are refused, as is a file whose extension
-        is not a vector format (:mod:`floodsph.io.vector`) and a ``crs`` pyproj cannot read.
+        (``polyline``, ``polygon``); both together are refused, as is a text table (a
+        ``.csv`` file: :mod:`floodsph.io.vector`) and a ``crs`` pyproj cannot read.
         """
-        from floodsph.io.vector import VECTOR_SUFFIXES, is_vector_file
+        from floodsph.io.vector import VECTOR_FORMATS, is_vector_file
 
         if "file" not in table:
             for key in ("layer", "crs"):
@@ -266,8 +266,9 @@ class Reader:
             raise self.fail(path, f"give either {inline} or file, not both")
         file = self.existing_file(table, path, "file")
         if not is_vector_file(file):
-            raise self.fail(join(path, "file"), f"{file.name}: not a vector file; expected "
-                                                f"one of {', '.join(VECTOR_SUFFIXES)}")
+            raise self.fail(join(path, "file"), f"{file.name}: not a vector file but a text "
+                                                f"table; expected a vector file "
+                                                f"({VECTOR_FORMATS})")
         crs = self.string(table, path, "crs", None)
         if crs is not None:
             import pyproj

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import logging
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -105,17 +106,44 @@ class Progress:
         self.bar.close()
 
 
-def log_progress(sim) -> None:
-    """One INFO line: simulated time, dt, particles, wall time and the sim/wall ratio."""
-    wall = sim.wall_time
-    ratio = sim.model.t / wall if wall > 0 else float("nan")
-    log.info(
-        "t = %.6g s of %g s, step %d, dt = %.3g s, %d particles, wall %.1f s (%.2fx real time)",
-        sim.model.t,
-        sim.end_time,
-        sim.model.steps,
-        sim.last_dt,
-        sim.n,
-        wall,
-        ratio,
-    )
+class ProgressLines:
+    """Progress as lines, for a log: every ``percent`` % of the simulated time and at least
+    every ``wall_s`` seconds of wall time (call it after every step).
+
+    Each line (:func:`progress_line`) is an INFO record of the ``floodsph`` logger, marked for
+    the run's ``floodsph.log`` only, and, when ``to_stderr``, also written to stderr: what a
+    batch log or a redirected stderr gets in place of the progress bar, which draws only on
+    a terminal.
+    """
+
+    def __init__(self, end_time: float, *, to_stderr: bool, percent: float = 10.0,
+                 wall_s: float = 60.0):
+        self.end_time = float(end_time)
+        self.to_stderr = to_stderr
+        self.step = self.end_time * percent / 100.0
+        self.wall_s = wall_s
+        self.next_time = self.step
+        self.last_wall = 0.0
+
+    def __call__(self, sim) -> None:
+        t, wall = float(sim.model.t), float(sim.wall_time)
+        if t < self.next_time - 1e-9 * self.end_time and wall - self.last_wall < self.wall_s:
+            return
+        while self.next_time <= t + 1e-9 * self.end_time:
+            self.next_time += self.step
+        self.last_wall = wall
+        line = progress_line(sim)
+        log.info("%s", line, extra={"file_only": True})
+        if self.to_stderr:
+            print(line, file=sys.stderr, flush=True)
+
+
+def progress_line(sim) -> str:
+    """``progress: t = 120 s of 1200 s (10 %), step 5400, dt = 0.02 s, 31000 particles,
+    wall 95 s (1.26x real time), about 855 s to go``."""
+    t, wall = float(sim.model.t), float(sim.wall_time)
+    ratio = t / wall if wall > 0 else float("nan")
+    left = (sim.end_time - t) / ratio if ratio > 0 else float("nan")
+    return (f"progress: t = {t:.6g} s of {sim.end_time:g} s ({100.0 * t / sim.end_time:.0f} %), "
+            f"step {sim.model.steps}, dt = {sim.last_dt:.3g} s, {sim.n} particles, wall "
+            f"{wall:.0f} s ({ratio:.2f}x real time), about {left:.0f} s to go")

@@ -9,7 +9,8 @@ Ctrl-C sends SIGINT. While :class:`StopSignals` is active each of them is caught
   a second signal while it does so is ignored, so the checkpoint is never cut short.
 
 Handlers can only be installed from the main thread; elsewhere (a dask worker, say) the
-class does nothing and the process's own handling applies.
+class does nothing and the process's own handling applies. An ensemble (never armed) uses it
+to turn each of the three signals into the :class:`RunInterrupted` of its own ending.
 """
 
 from __future__ import annotations
@@ -28,7 +29,9 @@ class RunInterrupted(KeyboardInterrupt):
 class StopSignals:
     """Context manager: catch the stop signals for the length of a run."""
 
-    def __init__(self):
+    def __init__(self, during: str = "during set-up", external=None):
+        self.during = during
+        self.external = external
         self.requested: str | None = None
         self.armed = False
         self._previous: dict = {}
@@ -49,8 +52,13 @@ class StopSignals:
             return
         self.requested = signal.Signals(signum).name
         if not self.armed:
-            raise RunInterrupted(f"interrupted by {self.requested} during set-up")
+            raise RunInterrupted(" ".join(filter(None, ("interrupted by", self.requested,
+                                                        self.during))))
 
     def __call__(self) -> bool:
-        """True once a stop was requested (the simulation's ``should_stop``)."""
+        """True once a stop was requested (the simulation's ``should_stop``): by a signal, or
+        by ``external() -> reason or None`` (an ensemble stopping its members on workers,
+        where no signal handler can be installed)."""
+        if self.requested is None and self.external is not None:
+            self.requested = self.external()
         return self.requested is not None

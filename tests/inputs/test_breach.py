@@ -211,3 +211,33 @@ def test_no_outflow_before_initiation_even_when_overtopped():
     assert np.all(Q[t <= 300.0] == 0.0)
     assert Q[t > 300.0][0] > 0.0
     assert s.time_to_peak_s > 300.0
+
+
+def test_routing_after_formation_follows_the_exact_level_time_relation():
+    """Constant area A, the breach formed at t_f with bottom at the invert: the head y obeys
+    A dy/dt = -C (b y^1.5 + k z y^2.5), so t - t_f = (A / C) int_y^{y_f} dh / (b h^1.5 + k z h^2.5),
+    integrated here by quadrature, independently of the routing's ODE solver."""
+    from scipy.integrate import quad
+    from scipy.optimize import brentq
+
+    from floodsph.breach.formulas import SIDE_TO_WEIR_RATIO, WEIR_COEFFICIENT
+
+    area = 2.0e5
+    t, Q, s = breach_hydrograph(BreachParams.from_mapping(
+        {"reservoir_area_m2": area, "breach_height_m": 15.0, "breach_invert_m": 230.0}))
+    b, k = s.bottom_width_m, SIDE_TO_WEIR_RATIO * s.side_slope
+
+    def weir(y):
+        return b * y**1.5 + k * y**2.5
+
+    def head(q):
+        return brentq(lambda y: WEIR_COEFFICIENT * weir(y) - q, 0.0, 20.0, xtol=1e-14)
+
+    formed = int(np.flatnonzero(np.isclose(t, s.formation_time_s, rtol=1e-12))[0])
+    y_f = head(Q[formed])
+    for i in np.linspace(formed + 1, len(t) - 2, 25).astype(int):
+        exact = area / WEIR_COEFFICIENT * quad(lambda h: 1.0 / weir(h), head(Q[i]), y_f,
+                                                epsabs=0.0, epsrel=1e-12)[0]
+        assert t[i] - t[formed] == pytest.approx(exact, rel=1e-6, abs=1e-3)
+    # The routing stops where the outflow has fallen to 1e-4 of its peak.
+    assert Q[-1] == pytest.approx(1e-4 * Q.max(), rel=1e-6)

@@ -53,7 +53,7 @@ def test_write_then_read_is_exact(tmp_path):
     back = read_hydrograph(tmp_path / "h.csv")
     np.testing.assert_array_equal(back.t, t)
     np.testing.assert_array_equal(back.Q, Q)
-    assert not (tmp_path / "h.csv.partial").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["h.csv"]  # no temporary left
 
 
 @pytest.mark.parametrize(

@@ -161,3 +161,75 @@ def test_geopackage_layer_in_web_mercator(write_scenario, tmp_path):
         text = BASE_SCENARIO + f'\n[[walls]]\nfile = "layers.gpkg"\n{extra}\n'
         with pytest.raises(InputError, match=r"walls\[0\]\.file layers\.gpkg: " + message):
             prepare_inputs(load_scenario(write_scenario(text)))
+
+
+def write_layer(path, geometries, crs, driver, **fields):
+    import shapely
+    from pyogrio.raw import write
+
+    write(path, np.array([shapely.to_wkb(g) for g in geometries], dtype=object),
+          [np.array(v, dtype=object) for v in fields.values()], list(fields), driver=driver,
+          geometry_type=geometries[0].geom_type, crs=crs)
+    return path
+
+
+def zipped_shapefile(tmp_path, geometries, crs):
+    import zipfile
+
+    folder = tmp_path / "shp"
+    folder.mkdir()
+    write_layer(folder / "dams.shp", geometries, crs, "ESRI Shapefile")
+    with zipfile.ZipFile(tmp_path / "dams.zip", "w") as archive:
+        for part in sorted(folder.iterdir()):  # .shp, .shx, .dbf and the .prj with the CRS
+            archive.write(part, part.name)
+    return tmp_path / "dams.zip"
+
+
+@pytest.mark.parametrize(("name", "crs", "driver"), [
+    ("dams.kml", "EPSG:4326", "KML"),
+    ("dams.gml", "EPSG:3857", "GML"),
+    ("dams.fgb", "EPSG:3857", "FlatGeobuf"),
+    ("dams.zip", "EPSG:3857", None),
+])
+def test_walls_from_each_gdal_format_land_where_pyproj_puts_them(write_scenario, tmp_path,
+                                                                 name, crs, driver):
+    import shapely
+
+    move = pyproj.Transformer.from_crs(CRS, crs, always_xy=True)
+    line = [shapely.LineString([move.transform(*p) for p in WALL_UTM])]
+    if driver is None:
+        zipped_shapefile(tmp_path, line, crs)
+    else:
+        write_layer(tmp_path / name, line, crs, driver)
+    text = BASE_SCENARIO + f'\n[[walls]]\nfile = "{name}"\n'
+    inputs = prepare_inputs(load_scenario(write_scenario(text)))
+    assert np.allclose(inputs.walls[0], local(WALL_UTM), atol=1e-3)
+
+
+def test_a_reservoir_with_an_island_keeps_the_island_dry(write_scenario, tmp_path):
+    """A GeoJSON polygon with a hole: a 60 m x 100 m island in the 2 m deep basin."""
+    island = [(X0 + 20.0, Y0 + 50.0), (X0 + 80.0, Y0 + 50.0), (X0 + 80.0, Y0 + 150.0),
+              (X0 + 20.0, Y0 + 150.0), (X0 + 20.0, Y0 + 50.0)]
+    write_geojson(tmp_path / "reservoir.geojson",
+                  feature("Polygon", [lonlat(DEM_RING_UTM), lonlat(island)]))
+    head, _, rest = BASE_SCENARIO.partition("[[initial_water]]")
+    text = (head + '[[initial_water]]\nlevel_m = 100.0\nfile = "reservoir.geojson"\n\n'
+            + rest[rest.index("[numerics]"):])
+    inputs = prepare_inputs(load_scenario(write_scenario(text)))
+    island_cells = 6 * 10
+    assert inputs.particles.n == 10 * NY - island_cells
+    assert inputs.volume_initial_m3 == pytest.approx(RESERVOIR_VOLUME_M3 * (1 - 60 / 200),
+                                                     rel=1e-6)
+
+
+def test_a_building_with_a_courtyard_is_two_closed_walls(write_scenario, tmp_path):
+    outline = [(X0 + 200.0, Y0 + 40.0), (X0 + 300.0, Y0 + 40.0), (X0 + 300.0, Y0 + 160.0),
+               (X0 + 200.0, Y0 + 160.0), (X0 + 200.0, Y0 + 40.0)]
+    yard = [(X0 + 230.0, Y0 + 70.0), (X0 + 270.0, Y0 + 70.0), (X0 + 270.0, Y0 + 130.0),
+            (X0 + 230.0, Y0 + 130.0), (X0 + 230.0, Y0 + 70.0)]
+    write_geojson(tmp_path / "b.geojson", feature("Polygon", [lonlat(outline), lonlat(yard)]))
+    inputs = prepare_inputs(load_scenario(write_scenario(
+        BASE_SCENARIO + '\n[[walls]]\nfile = "b.geojson"\n')))
+    assert len(inputs.walls) == 2
+    assert np.allclose(inputs.walls[0], local(outline), atol=1e-3)
+    assert np.allclose(inputs.walls[1], local(yard), atol=1e-3)

@@ -234,3 +234,28 @@ def test_maps_are_the_same_dataset_whatever_formats_the_run_wrote(envelopes, tmp
         xr.testing.assert_identical(ds, both)
         for name in ds.variables:
             assert ds[name].dtype == both[name].dtype, (formats, name)
+
+
+@pytest.mark.parametrize("fail_in", ["geotiff", "netcdf"])
+def test_a_writer_that_fails_half_way_leaves_the_old_file_and_no_temporary(
+        terrain, tmp_path, monkeypatch, fail_in):
+    grid = OutputGrid.from_terrain(terrain)
+    target = tmp_path / ("m.tif" if fail_in == "geotiff" else "m.nc")
+    target.write_bytes(b"the previous run's map")
+
+    def half_write(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    if fail_in == "geotiff":
+        monkeypatch.setattr("floodsph.output.geotiff._fill", half_write)
+        with pytest.raises(OSError, match="No space"):
+            write_geotiff(target, np.ones(grid.shape), grid, "max_depth", "m", driver="COG")
+    else:
+        monkeypatch.setattr(xr.Dataset, "to_netcdf",
+                            lambda self, part, **kw: (open(part, "wb").write(b"half"),
+                                                      half_write()))
+        with pytest.raises(OSError, match="No space"):
+            write_flood_maps(target, {"max_depth": np.ones(grid.shape)},
+                             {"max_depth": MAPS["max_depth"]}, grid, class_names={})
+    assert target.read_bytes() == b"the previous run's map"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [target.name]

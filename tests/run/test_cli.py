@@ -181,7 +181,8 @@ def test_check_reports_what_seeding_gives(scenario_file):
 def test_check_integrates_the_hydrograph(write_scenario, tmp_path):
     write_hydrograph(tmp_path, [(0, 0), (10, 6), (30, 0)])  # 30 + 45 = 75 m3 up to t = 20 s
     inflow = INFLOW.format(x1=X0 + 150, y1=Y0 + 50, x2=X0 + 150, y2=Y0 + 150)
-    result = invoke("check", write_scenario(BASE_SCENARIO + inflow))
+    # The floor is level there: a run (and so check) needs the direction.
+    result = invoke("check", write_scenario(BASE_SCENARIO + inflow + "direction = [1, 0]\n"))
     assert result.exit_code == 0, result.output
     assert "Inflow volume:   75 m3 up to the end time (1 inflows)" in result.output
 
@@ -288,3 +289,37 @@ def test_run_json_records_how_the_run_ended(scenario_file, tmp_path, exc, status
     assert not list(out.glob("*.tif")) and not (out / "flood_maps.nc").exists()
     # An unfinished run is not protected: it can be rerun without --overwrite.
     assert invoke("-q", "run", scenario_file, "-o", out, "--max-steps", "1").exit_code == 0
+
+
+def test_progress_reaches_a_piped_stderr_and_the_log_every_tenth_of_the_time(scenario_file):
+    """stderr is not a terminal here (no progress bar): a line per 10 % of the 20 s."""
+    result = invoke("run", scenario_file)
+    assert result.exit_code == 0, result.output
+    lines = [line for line in result.stderr.splitlines() if line.startswith("progress: ")]
+    percents = [int(line.split("(")[1].split(" %")[0]) for line in lines]
+    # One line at the first step past each tenth (a step is about 3 % of the time here).
+    assert [p // 10 for p in percents] == list(range(1, 11)), percents
+    assert "of 20 s" in lines[0] and "particles" in lines[0] and "to go" in lines[0]
+    log = (scenario_file.parent / "out" / "valley" / "floodsph.log").read_text()
+    assert [line.split("INFO floodsph.simulation.probes: ")[1] for line in log.splitlines()
+            if "progress: " in line] == lines
+    quiet = invoke("-q", "run", scenario_file, "--overwrite")
+    assert "progress: " not in quiet.stderr
+
+
+def test_progress_lines_come_every_minute_of_wall_time_between_tenths():
+    from types import SimpleNamespace
+
+    from floodsph.simulation.probes import ProgressLines
+
+    lines = ProgressLines(1000.0, to_stderr=False)
+    printed = []
+    for t, wall in [(5.0, 30.0), (6.0, 61.0), (7.0, 100.0), (8.0, 122.0), (100.0, 125.0),
+                    (150.0, 126.0)]:
+        sim = SimpleNamespace(model=SimpleNamespace(t=t, steps=1), wall_time=wall,
+                              end_time=1000.0, last_dt=0.1, n=10)
+        before = lines.last_wall
+        lines(sim)
+        printed.append(lines.last_wall != before)
+    # 61 s and 122 s of wall time, then 10 % of the time; 15 % waits for 20 %.
+    assert printed == [False, True, False, True, True, False]

@@ -232,6 +232,19 @@ def inflow_line_in_lonlat(folder):
             'hydrograph = "q.csv"\n')
 
 
+@case("gauges.csv: gauge file needs the columns id, x, y; found one column 'id;x;y': the "
+      "file is separated by semicolons; save it comma-separated")
+def gauges_separated_by_semicolons(folder):
+    (folder / "gauges.csv").write_text(f"id;x;y\nG1;{X0 + 50.0};{Y0 + 50.0}\n")
+    return BASE_SCENARIO + GAUGES
+
+
+@case("gauges.csv: gauge file needs the columns id, x, y; found the columns 'name', 'x', 'y'")
+def gauges_without_an_id_column(folder):
+    (folder / "gauges.csv").write_text(f"name,x,y\nG1,{X0 + 50.0},{Y0 + 50.0}\n")
+    return BASE_SCENARIO + GAUGES
+
+
 @case("gauges.csv, line 2: gauge 'G1'", "longitude/latitude")
 def gauge_in_lonlat(folder):
     (folder / "gauges.csv").write_text("id,x,y\nG1,9.01,45.02\n")
@@ -255,6 +268,27 @@ def no_water_at_all(folder):
 def inflow_after_the_end_time(folder):
     write_hydrograph(folder, ["100,0", "200,50"])
     return without_water() + INFLOW
+
+
+@case("scenario.toml: inflows: the hydrographs bring no water before end_time_s = 20 s")
+def hydrograph_of_zeros(folder):
+    write_hydrograph(folder, ["0,0", "10,0", "100,0"])
+    return without_water() + INFLOW
+
+
+# -- the side an inflow enters on ---------------------------------------------------------------
+
+@case("scenario.toml: inflows[0].direction: [0.0, 1.0] is parallel to the line")
+def inflow_direction_along_its_line(folder):
+    write_hydrograph(folder, ["0,10", "100,10"])
+    return BASE_SCENARIO + INFLOW + "direction = [0.0, 1.0]\n"
+
+
+@case("scenario.toml: inflows[0].direction: [1.0, 0.0] points off the DEM", "reverse it")
+def inflow_direction_off_the_dem(folder):
+    write_hydrograph(folder, ["0,10", "100,10"])
+    east_edge = INFLOW.replace(f"{X0 + 150.0}", f"{X1 - 5.0}")
+    return BASE_SCENARIO + east_edge + "direction = [1.0, 0.0]\n"
 
 
 @case("initial_water[0].polygon: the polygon contains no DEM cell centre")
@@ -339,7 +373,9 @@ IMPOSSIBLE_NUMBERS = [
 
 # -- too large for memory: refused before anything is allocated ------------------------------
 
-@case("scenario.toml: the run needs an estimated", "seeding lattice", "particle_spacing_m")
+@case("scenario.toml: the run needs an estimated", "particle_spacing_m",
+      "at peak (seeding lattice 814.9 TB (while seeding: the peak), program and libraries "
+      "500.0 MB, map grids 75.0 kB, terrain grids 50.0 kB) but only")
 def spacing_too_fine_for_memory(folder):
     return replaced(("particle_spacing_m = 10.0", "particle_spacing_m = 1e-4"))
 
@@ -593,6 +629,25 @@ polygon = [[{X0 + 200.0}, {Y0}], [{X1}, {Y0}], [{X1}, {Y1}]]
         "other water)"]
     result = invoke("check", scenario)
     assert result.exit_code == 0 and "WARNING: scenario.toml: initial_water[1]" in result.stderr
+
+
+@pytest.mark.parametrize(("direction", "warned"), [("[-1.0, 0.0]", True),
+                                                   ("[1.0, 0.0]", False)])
+def test_an_inflow_pointing_into_the_reservoir_is_warned(write_scenario, direction, warned):
+    # The line runs along the reservoir basin's eastern shore (x = 100 m): west is the
+    # reservoir (2 m of water), east the dry floor.
+    write_hydrograph(write_scenario().parent, ["0,10", "100,10"])
+    shore = INFLOW.replace(f"{X0 + 150.0}", f"{X0 + 100.0}")
+    scenario = write_scenario(BASE_SCENARIO + shore + f"direction = {direction}\n")
+    result = invoke("check", scenario)
+    assert result.exit_code == 0, result.output
+    expected = (f"WARNING: scenario.toml: inflows[0].direction: {direction} points into the "
+                "initial water")
+    assert (expected in result.stderr) == warned
+    assert prepared(scenario).warnings == ([expected.removeprefix("WARNING: ") + " (a reservoir?)"
+                                            " while the other side of the line is dry: the "
+                                            "inflow adds to that water instead of flowing away "
+                                            "from it"] if warned else [])
 
 
 def test_memory_is_estimated_from_the_dem_header_before_reading(valley_dem, scenario_file):
