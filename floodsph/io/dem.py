@@ -11,7 +11,8 @@ Steps (each failure is one :class:`~floodsph.errors.InputError` naming the file)
 4. fill small interior holes (``rasterio.fill.fillnodata``); larger nodata areas are outside
    the model (``valid = False``) and get the nearest valid elevation so bed derivatives stay
    finite;
-5. Manning n on the same grid (:mod:`floodsph.io.manning`);
+5. Manning n on the same grid (:mod:`floodsph.io.manning`), taken from the nearest cell in
+   the filled holes where the roughness raster has none there;
 6. flip to row 0 = south and set the local origin to the lower-left corner of the grid.
 """
 
@@ -107,6 +108,7 @@ def load_terrain(
         manning=manning,
         landcover=landcover,
         manning_table=manning_table,
+        filled=valid & ~np.isfinite(grid.values),
         warnings=warnings,
     )
     rows = grid.shape[0]
