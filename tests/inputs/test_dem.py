@@ -128,6 +128,36 @@ def test_netcdf_variable(tmp_path):
         load_terrain(path, dem_variable="nosuch")
 
 
+def test_netcdf_without_cf_coordinates_refused(tmp_path):
+    # x and y hold the coordinates but carry no units / standard_name: GDAL reads the pixel
+    # grid (the identity transform), with the grid mapping's CRS.
+    xr = pytest.importorskip("xarray")
+    x = 600_000.0 + 10.0 * (np.arange(12) + 0.5)
+    y = 4_000_000.0 + 10.0 * (np.arange(8) + 0.5)
+    ds = xr.Dataset(
+        {"bed": (("y", "x"), np.full((8, 12), 50.0), {"grid_mapping": "crs"}),
+         "crs": xr.DataArray(0, attrs={"crs_wkt": CRS.from_string(UTM32).to_wkt()})},
+        coords={"x": ("x", x), "y": ("y", y)},
+    )
+    ds.to_netcdf(tmp_path / "bare.nc")
+    with pytest.raises(InputError, match=r"bare.nc: the raster is not georeferenced.*units.*"
+                                         r"standard_name.*GeoTIFF"):
+        load_terrain(tmp_path / "bare.nc", dem_variable="bed")
+
+
+def test_geotiff_without_transform_refused(tmp_path):
+    path = tmp_path / "pixels.tif"
+    with rasterio.open(path, "w", driver="GTiff", width=5, height=5, count=1,
+                       dtype="float32", crs=UTM32) as dst:
+        dst.write(np.full((5, 5), 10.0, dtype=np.float32), 1)
+    with pytest.raises(InputError, match="pixels.tif: the raster is not georeferenced"):
+        load_terrain(path)
+    from floodsph.io.raster import read_header
+
+    with pytest.raises(InputError, match="pixels.tif: the raster is not georeferenced"):
+        read_header(path, what="DEM")
+
+
 def test_geographic_dem_reprojected_to_utm(tmp_path, caplog):
     # 0.0002 deg cells near 9.01 E, 45.005 N: ~15.7 m x 22.2 m; z linear in lon/lat.
     lon0, lat1, res = 9.0, 45.01, 0.0002
