@@ -47,7 +47,8 @@ class Inputs:
 
     ``walls`` (polylines) and ``sinks`` (polygons) are (k, 2) arrays, inline ones and those
     read from vector files alike. ``warnings`` lists the inputs accepted with a warning (each
-    also logged at WARNING).
+    also logged at WARNING); ``conversions`` the units the input files were converted from
+    (hydrographs in hours or cubic feet per second, dates), one sentence per file.
     """
 
     terrain: object
@@ -63,6 +64,7 @@ class Inputs:
     output_cells: int
     memory: MemoryEstimate
     warnings: list[str] = field(default_factory=list)
+    conversions: list[str] = field(default_factory=list)
 
 
 def prepare_inputs(scenario: Scenario) -> Inputs:
@@ -74,7 +76,8 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     tc = scenario.terrain
     source = str(scenario.path.name)
     warnings: list[str] = []
-    hydrographs = inflow_hydrographs(scenario)
+    conversions: list[str] = []
+    hydrographs = inflow_hydrographs(scenario, conversions)
     v_in = sum(float(hg.volume(0.0, scenario.end_time_s)) for hg in hydrographs)
     read = cells_read(scenario)
     check_memory(estimate_before_reading(scenario, v_in, read), source)
@@ -133,6 +136,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         output_cells=int(out_cells),
         memory=memory,
         warnings=warnings,
+        conversions=conversions,
     )
 
 
@@ -230,16 +234,18 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
     return depth
 
 
-def inflow_hydrographs(scenario: Scenario) -> list:
+def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None) -> list:
     """One :class:`~floodsph.inputs.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
-    one place it is read), or its breach (validated by ``floodsph.scenario.config``) routed."""
+    one place it is read; dates count from ``scenario.start``), or its breach (validated by
+    ``floodsph.scenario.config``) routed. ``conversions`` receives the units converted."""
     from floodsph.inputs.hydrograph import Hydrograph, read_hydrograph
 
     source = str(scenario.path.name)
     out = []
     for i, inflow in enumerate(scenario.inflows):
         if inflow.hydrograph is not None:
-            out.append(read_hydrograph(inflow.hydrograph, f"{source}: inflows[{i}].hydrograph"))
+            out.append(read_hydrograph(inflow.hydrograph, f"{source}: inflows[{i}].hydrograph",
+                                       start=scenario.start, conversions=conversions))
         else:
             from floodsph.breach import breach_hydrograph
 
@@ -275,4 +281,5 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"Peak memory:     ~{format_bytes(mem.total)} (estimate, {mem.particles_peak} particles "
         f"at peak); available {avail}",
         f"Warnings:        {len(inputs.warnings)}",
+        *(f"Converted:       {note}" for note in inputs.conversions),
     ]

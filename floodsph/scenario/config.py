@@ -12,6 +12,7 @@ when the model is built (``floodsph.run.pipeline``).
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from datetime import datetime
 from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -41,11 +42,19 @@ class OutputFormat(Enum):
 
 @dataclass(frozen=True)
 class ScenarioInfo:
-    """``[scenario]``: the name (also the default output folder) and the simulated time [s]."""
+    """``[scenario]``: the name (also the default output folder) and the simulated time [s].
+
+    ``start`` is the instant the run's clock starts from (timezone-aware; an instant written
+    without an offset is UTC), None when not given: hydrograph dates count from it.
+    ``crs`` is the CRS of the inline coordinates (polygons, lines, extents) when they are not
+    in the DEM file's own CRS (``floodsph.inputs.coordinates``).
+    """
 
     name: str
     end_time_s: float
     description: str = ""
+    start: datetime | None = None
+    crs: str | None = None
 
 
 @dataclass(frozen=True)
@@ -194,6 +203,11 @@ class Scenario:
         return self.scenario.end_time_s
 
     @property
+    def start(self) -> datetime | None:
+        """The instant t = 0 of the run (timezone-aware), or None."""
+        return self.scenario.start
+
+    @property
     def output_directory(self) -> Path:
         """The run folder: ``output.directory`` or ``<scenario folder>/out/<name>``."""
         if self.output.directory is not None:
@@ -241,6 +255,8 @@ def _plain(value):
         return value.value
     if isinstance(value, Path):
         return str(value)
+    if isinstance(value, datetime):
+        return value.isoformat()
     if isinstance(value, tuple | list):
         return [_plain(v) for v in value]
     if isinstance(value, dict):

@@ -137,6 +137,14 @@ SCENARIO = TableDoc("scenario", False, "What the scenario is called and how long
     KeyDoc("end_time_s", "number", "Simulated time at which the run ends (> 0).", "s",
            required=True),
     KeyDoc("description", "string", "Free text, kept in the run manifest."),
+    KeyDoc("start", "date-time", "The instant of t = 0, as an ISO 8601 date and time (a TOML "
+           "date-time or a string; without a UTC offset it is UTC). Hydrograph files with a "
+           "`time` column of dates count from it.",
+           absent="none (dates count from each file's first row)"),
+    KeyDoc("crs", "string", "The CRS of the inline coordinates (polygons, lines, extent, the "
+           "gauges CSV) when they are not in the DEM file's own CRS (`EPSG:4326`, a WKT or "
+           "PROJ string). Vector files keep their own CRS.",
+           absent="the DEM file's CRS"),
 ))
 
 TERRAIN = TableDoc("terrain", False, "The ground: elevation, roughness and what happens at "
@@ -188,8 +196,10 @@ INFLOWS = TableDoc("inflows", True, "A breach section where water enters the mod
                    "hydrograph or a parametric breach.", Inflow, keys=(
     KeyDoc("line", POINTS, "The section's two end points; water enters across it.", "m",
            required=True),
-    KeyDoc("hydrograph", "path", "CSV with columns time_s, discharge_m3s: the total discharge "
-           "through the section. Give this or [inflows.breach].", absent="none"),
+    KeyDoc("hydrograph", "path", "CSV of the total discharge through the section: time as "
+           "time_s, time_min or time_h, or time as ISO 8601 dates (counted from scenario.start, "
+           "else from the first row); discharge as discharge_m3s or discharge_cfs. Give this "
+           "or [inflows.breach].", absent="none"),
     KeyDoc("breach", "table", "A parametric breach turned into the hydrograph "
            "(see [inflows.breach]).", absent="none"),
     KeyDoc("direction", "[dx, dy]", "Direction of the entering flow (any length but zero).",
@@ -217,8 +227,8 @@ BREACH = TableDoc("inflows.breach", False, "A parametric dam breach (Froehlich 2
            "invert).", "m2", absent="V_w / h_w"),
     KeyDoc("storage_table", "path", "Instead of reservoir_area_m2: a CSV of elevation_m with "
            "volume_m3 or area_m2 (interpolated linearly).", absent="none"),
-    KeyDoc("inflow_hydrograph", "path", "Inflow into the reservoir during the breach, CSV "
-           "time_s, discharge_m3s.", absent="none"),
+    KeyDoc("inflow_hydrograph", "path", "Inflow into the reservoir during the breach, a CSV "
+           "as inflows.hydrograph (dates count from its first row).", absent="none"),
     KeyDoc("progression", "string", "How the breach grows over the formation time: `linear` or "
            "`sine`."),
     KeyDoc("weir_coefficient", "number", "C_w of the breach weir (side parts 2.45 / 3.1 C_w).",

@@ -10,6 +10,7 @@ the :class:`~floodsph.scenario.config.Scenario`.
 from __future__ import annotations
 
 from dataclasses import fields
+from datetime import UTC, datetime
 from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -86,16 +87,42 @@ def scenario_from_dict(data: dict, *, source: str, base_dir: Path) -> Scenario:
 def _info(r: Reader, data: dict) -> ScenarioInfo:
     if "scenario" not in data:
         raise r.fail("scenario", "required table [scenario] is missing")
-    t = r.sub_table(data, "", "scenario", ("name", "end_time_s", "description"))
+    t = r.sub_table(data, "", "scenario",
+                    ("name", "end_time_s", "description", "start", "crs"))
     name = r.string(t, "scenario", "name")
     problem = name_problem(name)
     if problem is not None:
         raise r.fail("scenario.name", problem)
+    crs = r.string(t, "scenario", "crs", None)
+    if crs is not None:
+        from floodsph.io.raster import parse_crs
+
+        parse_crs(crs, f"{r.source}: scenario.crs")
     return ScenarioInfo(
         name=name,
         end_time_s=r.number(t, "scenario", "end_time_s", gt=0.0),
         description=r.string(t, "scenario", "description", ""),
+        start=_start(r, t),
+        crs=crs,
     )
+
+
+def _start(r: Reader, t: dict) -> datetime | None:
+    """``scenario.start``: an ISO 8601 instant (a TOML date-time or a string); one without a
+    UTC offset is taken as UTC."""
+    value = t.get("start")
+    if value is None:
+        return None
+    if isinstance(value, str):
+        try:
+            value = datetime.fromisoformat(value.strip())
+        except ValueError:
+            raise r.fail("scenario.start", f"{value!r} is not an ISO 8601 instant "
+                         "(e.g. 2024-05-01T06:00:00Z)") from None
+    if not isinstance(value, datetime):
+        raise r.fail("scenario.start",
+                     f"expected an ISO 8601 date and time, got {describe(value)}")
+    return value if value.tzinfo is not None else value.replace(tzinfo=UTC)
 
 
 NAME_MAX_BYTES = 255
