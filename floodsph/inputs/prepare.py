@@ -30,10 +30,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from rasterio.crs import CRS
 
 from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
+from floodsph.inputs.coordinates import inline_to_model
 from floodsph.inputs.memory import MemoryEstimate, check_memory, estimate_memory, format_bytes
 from floodsph.inputs.vectors import vector_gauges, with_vector_geometry
 from floodsph.io.raster import crs_label
@@ -46,12 +48,15 @@ class Inputs:
     """What a run starts from (all coordinates local to the terrain's origin).
 
     ``walls`` (polylines) and ``sinks`` (polygons) are (k, 2) arrays, inline ones and those
-    read from vector files alike. ``warnings`` lists the inputs accepted with a warning (each
-    also logged at WARNING); ``conversions`` the units the input files were converted from
-    (hydrographs in hours or cubic feet per second, dates), one sentence per file.
+    read from vector files alike. ``inflows`` are the scenario's ``[[inflows]]`` with their
+    line and direction in the terrain's CRS (``floodsph.inputs.coordinates``). ``warnings``
+    lists the inputs accepted with a warning (each also logged at WARNING); ``conversions``
+    the units the input files were converted from (hydrographs in hours or cubic feet per
+    second, dates), one sentence per file.
     """
 
     terrain: object
+    inflows: tuple
     depth: np.ndarray
     particles: object
     spacing_m: float
@@ -90,10 +95,11 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         landcover=tc.landcover,
         manning_table=tc.manning_table,
         extent=tc.extent,
+        coordinates_crs=scenario.scenario.crs,
         warnings=warnings,
     )
     spacing = scenario.numerics.particle_spacing_m or float(min(terrain.dx, terrain.dy))
-    scenario = with_vector_geometry(scenario, terrain)
+    scenario = with_vector_geometry(inline_to_model(scenario, terrain), terrain)
     check_geometry_on_dem(scenario, terrain, spacing, source)
     wet = wet_cells(terrain, walled=tc.nodata_walled)
     dry: list[str] = []
@@ -124,6 +130,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     walls = [local_points(terrain, w.polyline) for w in scenario.walls]
     return Inputs(
         terrain=terrain,
+        inflows=scenario.inflows,
         depth=depth,
         particles=particles,
         spacing_m=spacing,
@@ -200,7 +207,7 @@ def estimate_before_reading(scenario: Scenario, volume_inflow_m3: float,
     tc = scenario.terrain
     header = read_header(tc.dem, variable=tc.dem_variable, crs=tc.crs, what="DEM")
     check_dem_size(header.shape, tc.dem)
-    grid = planned_grid(header, tc.extent)
+    grid = planned_grid(header, tc.extent, scenario.scenario.crs)
     spacing = scenario.numerics.particle_spacing_m or min(grid.dx, grid.dy)
     return _estimate(scenario, 0.0, volume_inflow_m3, spacing, grid.cells,
                      output_cells(scenario, (grid.rows, grid.cols), grid.dx, grid.dy),
@@ -254,6 +261,28 @@ def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None)
     return out
 
 
+def crs_lines(terrain) -> list[str]:
+    """The ``check`` lines on the CRSs: the model's and the maps' (with its scale factors over
+    the domain), the DEM file's when it differs, and the one of the inline coordinates."""
+    from floodsph.inputs.coordinates import coordinates_label
+    from floodsph.io.crs import scale_range
+
+    if not terrain.crs_wkt:
+        return [f"CRS:             {crs_label(terrain.crs_wkt)}"]
+    crs = CRS.from_wkt(terrain.crs_wkt)
+    lo, hi = scale_range(crs, terrain.north_up_transform(), terrain.shape)
+    lines = [f"CRS:             {crs_label(terrain.crs_wkt)} (the model and the maps), scale "
+             f"factor {lo:.5f} to {hi:.5f} over the domain"]
+    source = terrain.source_crs_wkt
+    if source and CRS.from_wkt(source) != crs:
+        found = ("geographic" if terrain.source_scale is None else
+                 f"scale factor {terrain.source_scale[0]:.5f} to {terrain.source_scale[1]:.5f}")
+        lines.append(f"DEM file CRS:    {crs_label(source)} ({found}); converted to the "
+                     "model's CRS")
+    lines.append(f"Coordinates:     {coordinates_label(terrain)} (inline coordinates)")
+    return lines
+
+
 def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> list[str]:
     """The ``floodsph check`` report: domain, CRS, volumes, particles, memory."""
     t = inputs.terrain
@@ -267,7 +296,7 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"End time:        {scenario.end_time_s:g} s",
         f"Domain:          {t.width / 1000:.3f} km x {t.height / 1000:.3f} km, "
         f"{nx} x {ny} cells of {t.dx:g} m x {t.dy:g} m ({valid} with data)",
-        f"CRS:             {crs_label(t.crs_wkt)}",
+        *crs_lines(t),
         f"Edges:           {scenario.terrain.edges.value}"
         + (f" (closed: {', '.join(scenario.terrain.closed_sides)})"
            if scenario.terrain.closed_sides else ""),

@@ -1,0 +1,173 @@
+"""One bowl, the DEM as engineers bring it: projected, geographic with lon/lat coordinates, Web
+Mercator; inline coordinates follow the DEM file, and messages name the CRS they are in."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import rasterio
+from rasterio.crs import CRS
+from rasterio.enums import Resampling
+from rasterio.transform import from_origin
+from rasterio.warp import calculate_default_transform, reproject
+from rasterio.warp import transform as warp_transform
+
+from floodsph.errors import InputError
+from floodsph.inputs.prepare import prepare_inputs, summary_lines
+from floodsph.scenario.reader import load_scenario
+
+UTM = CRS.from_epsg(32616)
+LONLAT = CRS.from_epsg(4326)
+MERCATOR = CRS.from_epsg(3857)
+CELL = 20.0
+N = 100  # 2 km x 2 km
+XC, YC = 500_000.0, 4_062_000.0  # the bowl's centre, -87.0 E, 36.70 N
+CURVATURE = 40_000.0  # z = 100 + r^2 / CURVATURE [m]
+LEVEL = 115.0
+BOWL_VOLUME_M3 = math.pi * CURVATURE * (LEVEL - 100.0) ** 2 / 2.0  # 14.14e6 m3
+HALF = 900.0  # the reservoir polygon: a square of +-900 m around the centre
+
+
+def bowl() -> tuple[np.ndarray, object]:
+    """North-up bowl elevations in UTM and their transform."""
+    x0, y1 = XC - N * CELL / 2, YC + N * CELL / 2
+    x = x0 + (np.arange(N) + 0.5) * CELL
+    y = y1 - (np.arange(N) + 0.5) * CELL
+    z = 100.0 + ((x[None, :] - XC) ** 2 + (y[:, None] - YC) ** 2) / CURVATURE
+    return z, from_origin(x0, y1, CELL, CELL)
+
+
+def write(path, z, transform, crs):
+    with rasterio.open(path, "w", driver="GTiff", width=z.shape[1], height=z.shape[0],
+                       count=1, dtype="float64", crs=crs, transform=transform,
+                       nodata=-9999.0) as dst:
+        dst.write(z, 1)
+    return path
+
+
+def warped(path, crs, resolution):
+    """The bowl reprojected to ``crs`` (bilinear), as a file in ``crs``."""
+    z, t = bowl()
+    left, top = t.c, t.f
+    dst_t, w, h = calculate_default_transform(UTM, crs, N, N, left, top - N * CELL,
+                                              left + N * CELL, top, resolution=resolution)
+    out = np.full((h, w), -9999.0)
+    reproject(z, out, src_transform=t, src_crs=UTM, dst_transform=dst_t, dst_crs=crs,
+              dst_nodata=-9999.0, resampling=Resampling.bilinear)
+    return write(path, out, dst_t, crs)
+
+
+def square_in(crs) -> list[list[float]]:
+    """The reservoir square's corners, written in ``crs``."""
+    xs = [XC - HALF, XC + HALF, XC + HALF, XC - HALF]
+    ys = [YC - HALF, YC - HALF, YC + HALF, YC + HALF]
+    if crs != UTM:
+        xs, ys = warp_transform(UTM, crs, xs, ys)
+    return [[float(x), float(y)] for x, y in zip(xs, ys, strict=True)]
+
+
+def scenario(tmp_path, dem, polygon, extra="", gauge=None):
+    text = f"""[scenario]
+name = "bowl"
+end_time_s = 10.0
+{extra}
+[terrain]
+dem = "{dem.name}"
+
+[[initial_water]]
+level_m = {LEVEL}
+polygon = {polygon}
+
+[numerics]
+particle_spacing_m = {CELL}
+"""
+    if gauge is not None:
+        (tmp_path / "gauges.csv").write_text(f"id,x,y\ng1,{gauge[0]!r},{gauge[1]!r}\n")
+        text += '\n[gauges]\nfile = "gauges.csv"\n'
+    path = tmp_path / "bowl.toml"
+    path.write_text(text)
+    return load_scenario(path)
+
+
+@pytest.fixture
+def forms(tmp_path):
+    """The bowl as a projected DEM, a geographic one and a Web Mercator one."""
+    z, t = bowl()
+    return {
+        "projected": write(tmp_path / "utm.tif", z, t, UTM),
+        "geographic": warped(tmp_path / "lonlat.tif", LONLAT, 0.0002),
+        "mercator": warped(tmp_path / "merc.tif", MERCATOR, CELL * 1.247),
+    }
+
+
+def test_every_form_of_the_bowl_holds_the_same_water(forms, tmp_path):
+    volumes = {}
+    for name, dem in forms.items():
+        crs = {"projected": UTM, "geographic": LONLAT, "mercator": MERCATOR}[name]
+        inputs = prepare_inputs(scenario(tmp_path, dem, square_in(crs)))
+        assert CRS.from_wkt(inputs.terrain.crs_wkt) == UTM, name
+        volumes[name] = inputs.volume_initial_m3
+    assert volumes["projected"] == pytest.approx(BOWL_VOLUME_M3, rel=0.01)
+    for name in ("geographic", "mercator"):
+        assert volumes[name] == pytest.approx(volumes["projected"], rel=0.005), volumes
+
+
+def test_lonlat_inline_coordinates_follow_a_geographic_dem(forms, tmp_path):
+    lon, lat = warp_transform(UTM, LONLAT, [XC + 300.0], [YC - 200.0])
+    sc = scenario(tmp_path, forms["geographic"], square_in(LONLAT), gauge=(lon[0], lat[0]))
+    inputs = prepare_inputs(sc)
+    t = inputs.terrain
+    # The gauge, given in lon/lat, sits 300 m east and 200 m south of the centre in UTM.
+    assert inputs.gauges.x[0] + t.x0 == pytest.approx(XC + 300.0, abs=1e-3)
+    assert inputs.gauges.y[0] + t.y0 == pytest.approx(YC - 200.0, abs=1e-3)
+    lines = summary_lines(sc, inputs, None)
+    assert "CRS:             EPSG:32616 (WGS 84 / UTM zone 16N) (the model and the maps)" \
+        in "\n".join(lines)
+    assert "Coordinates:     EPSG:4326 (WGS 84), the DEM file's CRS (inline coordinates)" \
+        in lines
+    assert [line for line in lines if line.startswith("DEM file CRS:    EPSG:4326")]
+
+
+def test_mercator_dem_check_reports_its_scale_factor(forms, tmp_path):
+    sc = scenario(tmp_path, forms["mercator"], square_in(MERCATOR))
+    inputs = prepare_inputs(sc)
+    line = [s for s in summary_lines(sc, inputs, None) if s.startswith("DEM file CRS:")][0]
+    lo, hi = (float(v) for v in line.split("scale factor ")[1].split(")")[0].split(" to "))
+    assert 1.2460 < lo < hi < 1.2485  # 1 / cos(36.7 deg) = 1.2472 at the centre
+    assert "EPSG:3857" in line
+    assert [w for w in inputs.warnings if "merc.tif" in w and "EPSG:32616" in w]
+
+
+def test_scenario_crs_gives_inline_coordinates_in_another_crs(forms, tmp_path):
+    sc = scenario(tmp_path, forms["projected"], square_in(LONLAT),
+                  extra='crs = "EPSG:4326"\n')
+    assert sc.scenario.crs == "EPSG:4326"
+    inputs = prepare_inputs(sc)
+    assert inputs.volume_initial_m3 == pytest.approx(BOWL_VOLUME_M3, rel=0.01)
+    assert "Coordinates:     EPSG:4326 (WGS 84), scenario.crs (inline coordinates)" in \
+        summary_lines(sc, inputs, None)
+
+
+def test_lonlat_polygon_over_a_projected_dem_names_the_file_crs_and_the_way_out(forms,
+                                                                               tmp_path):
+    sc = scenario(tmp_path, forms["projected"], square_in(LONLAT))
+    with pytest.raises(InputError) as err:
+        prepare_inputs(sc)
+    message = str(err.value)
+    assert message.startswith("bowl.toml: initial_water[0].polygon: the polygon lies wholly "
+                              "outside the DEM extent [499000, 4061000, 501000, 4063000] in "
+                              "EPSG:32616 (WGS 84 / UTM zone 16N), the DEM file's CRS")
+    assert message.endswith('; for longitude/latitude give [scenario] crs = "EPSG:4326"')
+
+
+def test_projected_polygon_over_a_geographic_dem_names_the_crs_it_is_read_in(forms, tmp_path):
+    # Metres where the DEM file (EPSG:4326) says degrees: one message naming both CRSs.
+    sc = scenario(tmp_path, forms["geographic"], square_in(UTM))
+    with pytest.raises(InputError) as err:
+        prepare_inputs(sc)
+    message = str(err.value)
+    assert "initial_water[0].polygon" in message
+    assert "EPSG:4326 (WGS 84), the DEM file's CRS" in message
+    assert "[scenario] crs" in message and "EPSG:32616" in message
