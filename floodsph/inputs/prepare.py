@@ -181,10 +181,11 @@ def _estimate(scenario, n_initial, v_in, spacing, dem_cells, out_cells, lattice,
 def cells_read(scenario: Scenario) -> float:
     """Cells of the rasters held at once while the terrain is loaded, from their headers: the
     DEM file and the largest of the Manning, land-cover and depth rasters (each read whole)."""
+    from floodsph.io.mosaic import read_dem_header
     from floodsph.io.raster import read_header
 
     tc = scenario.terrain
-    dem = read_header(tc.dem, variable=tc.dem_variable, crs=tc.crs, what="DEM").cells
+    dem = read_dem_header(tc.dem, variable=tc.dem_variable, crs=tc.crs).cells
     others = [(tc.landcover, "landcover")]
     if isinstance(tc.manning, Path):
         others.append((tc.manning, "manning raster"))
@@ -202,11 +203,11 @@ def estimate_before_reading(scenario: Scenario, volume_inflow_m3: float,
     grids, the seeding lattice and the inflow particles (no initial particles yet: they need
     the depth grid)."""
     from floodsph.io.dem import check_dem_size, planned_grid
-    from floodsph.io.raster import read_header
+    from floodsph.io.mosaic import read_dem_header, tile_names
 
     tc = scenario.terrain
-    header = read_header(tc.dem, variable=tc.dem_variable, crs=tc.crs, what="DEM")
-    check_dem_size(header.shape, tc.dem)
+    header = read_dem_header(tc.dem, variable=tc.dem_variable, crs=tc.crs)
+    check_dem_size(header.shape, tile_names(tc.dem))
     grid = planned_grid(header, tc.extent, scenario.scenario.crs)
     spacing = scenario.numerics.particle_spacing_m or min(grid.dx, grid.dy)
     return _estimate(scenario, 0.0, volume_inflow_m3, spacing, grid.cells,

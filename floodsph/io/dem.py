@@ -2,7 +2,8 @@
 
 Steps (each failure is one :class:`~floodsph.errors.InputError` naming the file):
 
-1. read band 1 (GeoTIFF, ESRI ASCII ``.asc`` + ``.prj``, NetCDF variable), nodata -> NaN;
+1. read band 1 (GeoTIFF, ESRI ASCII ``.asc`` + ``.prj``, NetCDF variable, or the mosaic of
+   several such tiles: :mod:`floodsph.io.mosaic`), nodata -> NaN;
    refuse a grid under 3 x 3 cells and undeclared fill values (:mod:`floodsph.checks.elevation`),
    convert elevations in feet to metres;
 2. bring the grid to ground metres (:mod:`floodsph.io.crs`): a projected CRS in feet becomes
@@ -47,7 +48,8 @@ from floodsph.io.crs import (
     scale_range,
 )
 from floodsph.io.manning import manning_grid
-from floodsph.io.raster import Grid, GridHeader, crs_label, parse_crs, read_grid
+from floodsph.io.mosaic import read_dem_grid, tile_names
+from floodsph.io.raster import Grid, GridHeader, crs_label, parse_crs
 from floodsph.model.terrain import Terrain
 
 log = logging.getLogger(__name__)
@@ -77,8 +79,9 @@ def load_terrain(
 
     Parameters
     ----------
-    dem_path : str or Path
-        GeoTIFF, ESRI ASCII grid or NetCDF file of bed elevation [m].
+    dem_path : str, Path or tuple of Path
+        GeoTIFF, ESRI ASCII grid or NetCDF file of bed elevation [m], or a tuple of tiles
+        mosaicked into one grid (:mod:`floodsph.io.mosaic`).
     crs : str, optional
         CRS for a file that carries none (``"EPSG:27572"``).
     dem_variable : str, optional
@@ -105,8 +108,8 @@ def load_terrain(
     Terrain
         Row 0 = south; ``x0, y0`` = world coordinates of the lower-left grid corner.
     """
-    path = Path(dem_path)
-    grid = read_grid(path, variable=dem_variable, crs=crs, what="DEM", warnings=warnings)
+    path = tile_names(dem_path) if isinstance(dem_path, tuple) else Path(dem_path)
+    grid = read_dem_grid(dem_path, variable=dem_variable, crs=crs, warnings=warnings)
     if not np.any(np.isfinite(grid.values)):
         raise InputError(f"DEM {path}: every cell is nodata")
     check_dem_size(grid.shape, path)

@@ -180,7 +180,7 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         manning = None
     edges = r.choice(t, p, "edges", Edges, TerrainConfig.edges)
     return TerrainConfig(
-        dem=r.existing_file(t, p, "dem"),
+        dem=_dem(r, t, p),
         crs=r.string(t, p, "crs", None),
         dem_variable=r.string(t, p, "dem_variable", None),
         manning=manning,
@@ -190,6 +190,30 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         edges=edges,
         closed_sides=_closed_sides(r, t, p, edges),
     )
+
+
+def _dem(r: Reader, t: dict, p: str) -> Path | tuple[Path, ...]:
+    """``terrain.dem``: one file, a list of tile files, or a glob pattern (``*``, ``?``,
+    ``[...]``) of tiles, relative to the scenario's folder; several files are a tuple in the
+    order given (a glob's in sorted order), one file a path."""
+    where = join(p, "dem")
+    if "dem" not in t:
+        raise r.fail(where, "required key is missing")
+    value = t["dem"]
+    if isinstance(value, list):
+        if not value or not all(isinstance(v, str) for v in value):
+            raise r.fail(where, f"expected a path or a list of paths, got {describe(value)}")
+        files = tuple(r.file_value(v, join(where, i)) for i, v in enumerate(value))
+    elif isinstance(value, str) and any(c in value for c in "*?["):
+        pattern = r.resolve(value, where)
+        files = tuple(sorted(f for f in pattern.parent.glob(pattern.name) if f.is_file()))
+        if not files:
+            raise r.fail(where, f"no file matches {pattern}")
+    else:
+        return r.existing_file(t, p, "dem")
+    if len(set(files)) != len(files):
+        raise r.fail(where, "a tile is named twice")
+    return files[0] if len(files) == 1 else files
 
 
 def _manning_table(r: Reader, t: dict, p: str) -> Path | str | None:

@@ -171,3 +171,62 @@ def test_projected_polygon_over_a_geographic_dem_names_the_crs_it_is_read_in(for
     assert "initial_water[0].polygon" in message
     assert "EPSG:4326 (WGS 84), the DEM file's CRS" in message
     assert "[scenario] crs" in message and "EPSG:32616" in message
+
+
+def tiles(tmp_path, east_crs=UTM):
+    """The bowl split in a west and an east tile that overlap by 10 columns, with different
+    nodata values (-9999 and -32768); the east tile in ``east_crs``."""
+    z, t = bowl()
+    west = write(tmp_path / "bowl_w.tif", z[:, :55], t, UTM)
+    east_t = from_origin(t.c + 45 * CELL, t.f, CELL, CELL)
+    with rasterio.open(tmp_path / "bowl_e.tif", "w", driver="GTiff", width=55, height=N,
+                       count=1, dtype="float32", crs=UTM, transform=east_t,
+                       nodata=-32768.0) as dst:
+        dst.write(z[:, 45:].astype(np.float32), 1)
+    east = tmp_path / "bowl_e.tif"
+    if east_crs != UTM:
+        with rasterio.open(east) as src:
+            data, src_t = src.read(1).astype(np.float64), src.transform
+        dst_t, w, h = calculate_default_transform(UTM, east_crs, 55, N,
+                                                  *rasterio.transform.array_bounds(N, 55, src_t))
+        out = np.full((h, w), -9999.0)
+        reproject(data, out, src_transform=src_t, src_crs=UTM, dst_transform=dst_t,
+                  dst_crs=east_crs, dst_nodata=-9999.0, resampling=Resampling.bilinear)
+        east = write(tmp_path / "bowl_e_lonlat.tif", out, dst_t, east_crs)
+    return west, east
+
+
+def test_two_tiles_make_the_dem_they_were_cut_from(forms, tmp_path):
+    whole = prepare_inputs(scenario(tmp_path, forms["projected"], square_in(UTM)))
+    tiles(tmp_path)
+    text = (tmp_path / "bowl.toml").read_text().replace('dem = "utm.tif"', 'dem = "bowl_?.tif"')
+    (tmp_path / "bowl.toml").write_text(text)
+    sc = load_scenario(tmp_path / "bowl.toml")
+    assert sc.terrain.dem == (tmp_path / "bowl_e.tif", tmp_path / "bowl_w.tif")
+    mosaic = prepare_inputs(sc)
+    t = mosaic.terrain
+    assert (t.x0, t.y0, t.shape) == (whole.terrain.x0, whole.terrain.y0, (N, N))
+    assert t.valid.all()
+    # float32 east tile: elevations to float32 round-off, the same water to 1e-6.
+    np.testing.assert_allclose(t.elevation, whole.terrain.elevation, rtol=0, atol=2e-5)
+    assert mosaic.volume_initial_m3 == pytest.approx(whole.volume_initial_m3, rel=1e-6)
+
+
+def test_a_tile_in_another_crs_is_reprojected_to_the_first_ones(forms, tmp_path):
+    whole = prepare_inputs(scenario(tmp_path, forms["projected"], square_in(UTM)))
+    west, east = tiles(tmp_path, east_crs=LONLAT)
+    text = (tmp_path / "bowl.toml").read_text().replace(
+        'dem = "utm.tif"', f'dem = ["{west.name}", "{east.name}"]')
+    (tmp_path / "bowl.toml").write_text(text)
+    inputs = prepare_inputs(load_scenario(tmp_path / "bowl.toml"))
+    assert [w for w in inputs.warnings if "bowl_e_lonlat.tif is in EPSG:4326" in w]
+    assert CRS.from_wkt(inputs.terrain.crs_wkt) == UTM
+    assert inputs.volume_initial_m3 == pytest.approx(whole.volume_initial_m3, rel=0.005)
+
+
+def test_a_glob_that_matches_nothing_names_the_key(forms, tmp_path):
+    sc = tmp_path / "bowl.toml"
+    scenario(tmp_path, forms["projected"], square_in(UTM))
+    sc.write_text(sc.read_text().replace('dem = "utm.tif"', 'dem = "N36W08*.tif"'))
+    with pytest.raises(InputError, match=r"bowl.toml: terrain.dem: no file matches .*N36W08\*"):
+        load_scenario(sc)
