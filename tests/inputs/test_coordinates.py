@@ -290,3 +290,32 @@ formats = ["geotiff"]
         depth = maps[name][Resampling.bilinear]
         np.testing.assert_allclose(depth[inner], reference[inner], atol=0.1, err_msg=name)
         assert depth.sum() == pytest.approx(reference.sum(), rel=0.005), name
+
+
+def test_extent_inflow_line_and_direction_in_lonlat_follow_the_geographic_dem(forms, tmp_path):
+    sc = scenario(tmp_path, forms["geographic"], square_in(LONLAT))
+    (tmp_path / "q.csv").write_text("time_s,discharge_m3s\n0,1\n10,1\n")
+    (lon0, lon1), (lat0, lat1) = warp_transform(UTM, LONLAT, [XC - 600.0, XC + 600.0],
+                                                [YC - 500.0, YC + 500.0])
+    (a_lon, b_lon), (a_lat, b_lat) = warp_transform(UTM, LONLAT, [XC - 400.0, XC - 400.0],
+                                                    [YC - 100.0, YC + 100.0])
+    text = sc.path.read_text().replace(
+        "[terrain]\n", f"[terrain]\nextent = [{lon0!r}, {lat0!r}, {lon1!r}, {lat1!r}]\n")
+    text += (f"\n[[inflows]]\nline = [[{a_lon!r}, {a_lat!r}], [{b_lon!r}, {b_lat!r}]]\n"
+             'hydrograph = "q.csv"\ndirection = [1.0, 0.0]\n')
+    sc.path.write_text(text)
+    inputs = prepare_inputs(load_scenario(sc.path))
+    t = inputs.terrain
+    # The crop: 1200 m x 1000 m of whole ~19.9 m cells around the centre.
+    assert t.width == pytest.approx(1200.0, abs=2 * t.dx)
+    assert t.height == pytest.approx(1000.0, abs=2 * t.dy)
+    assert t.x0 == pytest.approx(XC - 600.0, abs=t.dx)
+    np.testing.assert_allclose(inputs.inflows[0].line, [(XC - 400.0, YC - 100.0),
+                                                        (XC - 400.0, YC + 100.0)], atol=1e-3)
+    dx, dy = inputs.inflows[0].direction
+    assert dx > 0 and abs(dy / dx) < 1e-3  # east in lon/lat is east in UTM on its meridian
+
+
+def test_a_scenario_crs_that_is_no_crs_names_the_key(forms, tmp_path):
+    with pytest.raises(InputError, match=r"bowl.toml: scenario.crs: 'EPSG:99999' is not a "):
+        scenario(tmp_path, forms["projected"], square_in(UTM), extra='crs = "EPSG:99999"\n')
