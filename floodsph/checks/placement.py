@@ -3,17 +3,20 @@
 Checked once the DEM is read (:func:`check_geometry_on_dem`), each message naming the key
 path: every polygon and wall overlaps the DEM rectangle (a part outside is allowed: a
 reservoir outline drawn beyond a cropped DEM), every inflow line end lies on DEM data and the
-line is at least half a particle spacing long. Geometry given in longitude/latitude over a
-projected DEM is named as such (:func:`lonlat_hint`).
+line is at least half a particle spacing long. The geometry is in the model's CRS by then
+(``floodsph.inputs.coordinates``); messages give the DEM's extent and the points in the CRS the
+inline coordinates are in, naming it, and name geometry that looks like longitude/latitude
+where that CRS is projected (:func:`lonlat_hint`).
 """
 
 from __future__ import annotations
 
 import numpy as np
+import pyproj
 import shapely
 
 from floodsph.errors import InputError
-from floodsph.io.raster import crs_label
+from floodsph.inputs.coordinates import coordinates_label, coordinates_wkt, moved, to_user
 
 INFLOW_MIN_SPACINGS = 0.5
 """An inflow line shorter than this many particle spacings is refused: its buffer rows hold
@@ -34,41 +37,64 @@ def extent_text(terrain) -> str:
     """``[xmin, ymin, xmax, ymax]`` of the DEM in world coordinates, for messages."""
     x0, y0 = terrain.x0, terrain.y0
     values = (x0, y0, x0 + terrain.width, y0 + terrain.height)
-    return "[" + ", ".join(f"{v:g}" for v in values) + "]"
+    return "[" + ", ".join(f"{v:.10g}" for v in values) + "]"
+
+
+def user_extent_text(terrain) -> str:
+    """The DEM's extent in the CRS of the inline coordinates, naming that CRS, for messages:
+    ``[xmin, ymin, xmax, ymax] in EPSG:4326 (WGS 84), the DEM file's CRS``."""
+    if not terrain.crs_wkt:
+        return extent_text(terrain)
+    if not moved(terrain):
+        return f"{extent_text(terrain)} in {coordinates_label(terrain)}"
+    corners = shapely.get_coordinates(shapely.segmentize(dem_box(terrain),
+                                                         max(terrain.width, terrain.height) / 20))
+    user = to_user(terrain, corners)
+    values = (*user.min(axis=0), *user.max(axis=0))
+    return "[" + ", ".join(f"{v:.10g}" for v in values) + f"] in {coordinates_label(terrain)}"
 
 
 def lonlat_hint(points, terrain) -> str:
-    """A sentence for geometry that looks like longitude/latitude over a projected DEM, or ''."""
+    """A sentence for geometry (given in the model's CRS) that looks like longitude/latitude
+    in degrees where the inline coordinates are in a projected CRS, or ''."""
     if not terrain.crs_wkt:
         return ""
-    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    wkt = coordinates_wkt(terrain)
+    if pyproj.CRS.from_wkt(wkt).is_geographic:
+        return ""
+    p = to_user(terrain, points)
     xmin, ymin, xmax, ymax = LONLAT_BOX
 
     def in_box(x, y):
         return bool(np.all((x >= xmin) & (x <= xmax) & (y >= ymin) & (y <= ymax)))
 
-    corners = shapely.get_coordinates(dem_box(terrain))
-    if not in_box(p[:, 0], p[:, 1]) or in_box(corners[:, 0], corners[:, 1]):
+    corners = to_user(terrain, shapely.get_coordinates(dem_box(terrain)))
+    if not np.all(np.isfinite(p)) or not in_box(p[:, 0], p[:, 1]) \
+            or in_box(corners[:, 0], corners[:, 1]):
         return ""
-    return ("; its coordinates look like longitude/latitude in degrees, but they must be in "
-            f"the DEM's CRS ({crs_label(terrain.crs_wkt)}, metres)")
+    return ("; its coordinates look like longitude/latitude in degrees, but inline coordinates "
+            f"are in {coordinates_label(terrain)}; for longitude/latitude give "
+            '[scenario] crs = "EPSG:4326"')
 
 
 def off_dem_error(where: str, what: str, points, terrain) -> InputError:
-    """``<where>: <what> outside the DEM extent [...]`` with the longitude/latitude hint."""
-    return InputError(f"{where}: {what} outside the DEM extent {extent_text(terrain)}"
+    """``<where>: <what> outside the DEM extent [...] in <CRS>`` with the longitude/latitude
+    hint; ``points`` are in the model's CRS."""
+    return InputError(f"{where}: {what} outside the DEM extent {user_extent_text(terrain)}"
                       f"{lonlat_hint(points, terrain)}")
 
 
 def check_point_on_dem(terrain, point, where: str) -> None:
-    """Refuse a world point off the DEM grid or on a nodata cell."""
+    """Refuse a world point (the model's CRS) off the DEM grid or on a nodata cell; the
+    message gives it in the coordinates' CRS."""
     x, y = terrain.to_local(point[0], point[1])
     col, row = int(np.floor(x / terrain.dx)), int(np.floor(y / terrain.dy))
     ny, nx = terrain.shape
+    ux, uy = to_user(terrain, [point])[0] if terrain.crs_wkt else point
     if not (0 <= col < nx and 0 <= row < ny):
-        raise off_dem_error(where, f"point [{point[0]:g}, {point[1]:g}] is", [point], terrain)
+        raise off_dem_error(where, f"point [{ux:.10g}, {uy:.10g}] is", [point], terrain)
     if not terrain.valid[row, col]:
-        raise InputError(f"{where}: point [{point[0]:g}, {point[1]:g}] lies on DEM nodata")
+        raise InputError(f"{where}: point [{ux:.10g}, {uy:.10g}] lies on DEM nodata")
 
 
 def check_geometry_on_dem(scenario, terrain, spacing_m: float, source: str) -> None:

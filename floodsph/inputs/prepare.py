@@ -32,11 +32,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from rasterio.crs import CRS
 
 from floodsph.checks.inflows import check_inflows
 from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
+from floodsph.inputs.coordinates import inline_to_model
 from floodsph.inputs.memory import MemoryEstimate, check_memory, estimate_memory, format_bytes
 from floodsph.inputs.run_time import estimate_run_time, run_threads, warn_if_huge
 from floodsph.inputs.vectors import vector_gauges, with_vector_geometry
@@ -50,11 +52,15 @@ class Inputs:
     """What a run starts from (all coordinates local to the terrain's origin).
 
     ``walls`` (polylines) and ``sinks`` (polygons) are (k, 2) arrays, inline ones and those
-    read from vector files alike. ``warnings`` lists the inputs accepted with a warning (each
-    also logged at WARNING).
+    read from vector files alike. ``inflows`` are the scenario's ``[[inflows]]`` with their
+    line and direction in the terrain's CRS (``floodsph.inputs.coordinates``). ``warnings``
+    lists the inputs accepted with a warning (each also logged at WARNING); ``conversions``
+    the units the input files were converted from (hydrographs in hours or cubic feet per
+    second, dates), one sentence per file.
     """
 
     terrain: object
+    inflows: tuple
     depth: np.ndarray
     particles: object
     spacing_m: float
@@ -67,6 +73,7 @@ class Inputs:
     output_cells: int
     memory: MemoryEstimate
     warnings: list[str] = field(default_factory=list)
+    conversions: list[str] = field(default_factory=list)
 
 
 def prepare_inputs(scenario: Scenario) -> Inputs:
@@ -78,7 +85,8 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     tc = scenario.terrain
     source = str(scenario.path.name)
     warnings: list[str] = []
-    hydrographs = inflow_hydrographs(scenario)
+    conversions: list[str] = []
+    hydrographs = inflow_hydrographs(scenario, conversions)
     v_in = sum(float(hg.volume(0.0, scenario.end_time_s)) for hg in hydrographs)
     read = cells_read(scenario)
     check_memory(estimate_before_reading(scenario, v_in, read), source)
@@ -91,10 +99,11 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         landcover=tc.landcover,
         manning_table=tc.manning_table,
         extent=tc.extent,
+        coordinates_crs=scenario.scenario.crs,
         warnings=warnings,
     )
     spacing = scenario.numerics.particle_spacing_m or float(min(terrain.dx, terrain.dy))
-    scenario = with_vector_geometry(scenario, terrain)
+    scenario = with_vector_geometry(inline_to_model(scenario, terrain), terrain)
     check_geometry_on_dem(scenario, terrain, spacing, source)
     wet = wet_cells(terrain, walled=tc.nodata_walled)
     dry: list[str] = []
@@ -128,6 +137,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     walls = [local_points(terrain, w.polyline) for w in scenario.walls]
     return Inputs(
         terrain=terrain,
+        inflows=scenario.inflows,
         depth=depth,
         particles=particles,
         spacing_m=spacing,
@@ -140,6 +150,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         output_cells=int(out_cells),
         memory=memory,
         warnings=warnings,
+        conversions=conversions,
     )
 
 
@@ -177,10 +188,11 @@ def _estimate(scenario, n_initial, v_in, spacing, dem_cells, out_cells, lattice,
 def cells_read(scenario: Scenario) -> float:
     """Cells of the rasters held at once while the terrain is loaded, from their headers: the
     DEM file and the largest of the Manning, land-cover and depth rasters (each read whole)."""
+    from floodsph.io.mosaic import read_dem_header
     from floodsph.io.raster import read_header
 
     tc = scenario.terrain
-    dem = read_header(tc.dem, variable=tc.dem_variable, crs=tc.crs, what="DEM").cells
+    dem = read_dem_header(tc.dem, variable=tc.dem_variable, crs=tc.crs).cells
     others = [(tc.landcover, "landcover")]
     if isinstance(tc.manning, Path):
         others.append((tc.manning, "manning raster"))
@@ -198,12 +210,12 @@ def estimate_before_reading(scenario: Scenario, volume_inflow_m3: float,
     grids, the seeding lattice and the inflow particles (no initial particles yet: they need
     the depth grid)."""
     from floodsph.io.dem import check_dem_size, planned_grid
-    from floodsph.io.raster import read_header
+    from floodsph.io.mosaic import read_dem_header, tile_names
 
     tc = scenario.terrain
-    header = read_header(tc.dem, variable=tc.dem_variable, crs=tc.crs, what="DEM")
-    check_dem_size(header.shape, tc.dem)
-    grid = planned_grid(header, tc.extent)
+    header = read_dem_header(tc.dem, variable=tc.dem_variable, crs=tc.crs)
+    check_dem_size(header.shape, tile_names(tc.dem))
+    grid = planned_grid(header, tc.extent, scenario.scenario.crs)
     spacing = scenario.numerics.particle_spacing_m or min(grid.dx, grid.dy)
     return _estimate(scenario, 0.0, volume_inflow_m3, spacing, grid.cells,
                      output_cells(scenario, (grid.rows, grid.cols), grid.dx, grid.dy),
@@ -237,22 +249,46 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
     return depth
 
 
-def inflow_hydrographs(scenario: Scenario) -> list:
+def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None) -> list:
     """One :class:`~floodsph.inputs.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
-    one place it is read), or its breach (validated by ``floodsph.scenario.config``) routed."""
+    one place it is read; dates count from ``scenario.start``), or its breach (validated by
+    ``floodsph.scenario.config``) routed. ``conversions`` receives the units converted."""
     from floodsph.inputs.hydrograph import Hydrograph, read_hydrograph
 
     source = str(scenario.path.name)
     out = []
     for i, inflow in enumerate(scenario.inflows):
         if inflow.hydrograph is not None:
-            out.append(read_hydrograph(inflow.hydrograph, f"{source}: inflows[{i}].hydrograph"))
+            out.append(read_hydrograph(inflow.hydrograph, f"{source}: inflows[{i}].hydrograph",
+                                       start=scenario.start, conversions=conversions))
         else:
             from floodsph.breach import breach_hydrograph
 
             t, Q, _ = breach_hydrograph(inflow.breach)
             out.append(Hydrograph(t, Q))
     return out
+
+
+def crs_lines(terrain) -> list[str]:
+    """The ``check`` lines on the CRSs: the model's and the maps' (with its scale factors over
+    the domain), the DEM file's when it differs, and the one of the inline coordinates."""
+    from floodsph.inputs.coordinates import coordinates_label
+    from floodsph.io.crs import scale_range
+
+    if not terrain.crs_wkt:
+        return [f"CRS:             {crs_label(terrain.crs_wkt)}"]
+    crs = CRS.from_wkt(terrain.crs_wkt)
+    lo, hi = scale_range(crs, terrain.north_up_transform(), terrain.shape)
+    lines = [f"CRS:             {crs_label(terrain.crs_wkt)} (the model and the maps), scale "
+             f"factor {lo:.5f} to {hi:.5f} over the domain"]
+    source = terrain.source_crs_wkt
+    if source and CRS.from_wkt(source) != crs:
+        found = ("geographic" if terrain.source_scale is None else
+                 f"scale factor {terrain.source_scale[0]:.5f} to {terrain.source_scale[1]:.5f}")
+        lines.append(f"DEM file CRS:    {crs_label(source)} ({found}); converted to the "
+                     "model's CRS")
+    lines.append(f"Coordinates:     {coordinates_label(terrain)} (inline coordinates)")
+    return lines
 
 
 def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> list[str]:
@@ -268,7 +304,7 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"End time:        {scenario.end_time_s:g} s",
         f"Domain:          {t.width / 1000:.3f} km x {t.height / 1000:.3f} km, "
         f"{nx} x {ny} cells of {t.dx:g} m x {t.dy:g} m ({valid} with data)",
-        f"CRS:             {crs_label(t.crs_wkt)}",
+        *crs_lines(t),
         f"Edges:           {scenario.terrain.edges.value}"
         + (f" (closed: {', '.join(scenario.terrain.closed_sides)})"
            if scenario.terrain.closed_sides else ""),
@@ -283,4 +319,5 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"particles at peak); available {avail}",
         f"Run time:        {estimate_run_time(scenario, inputs, run_threads(scenario)).text()}",
         f"Warnings:        {len(inputs.warnings)}",
+        *(f"Converted:       {note}" for note in inputs.conversions),
     ]

@@ -2,16 +2,21 @@
 
 Steps (each failure is one :class:`~floodsph.errors.InputError` naming the file):
 
-1. read band 1 (GeoTIFF, ESRI ASCII ``.asc`` + ``.prj``, NetCDF variable), nodata -> NaN;
+1. read band 1 (GeoTIFF, ESRI ASCII ``.asc`` + ``.prj``, NetCDF variable, or the mosaic of
+   several such tiles: :mod:`floodsph.io.mosaic`), nodata -> NaN;
    refuse a grid under 3 x 3 cells and undeclared fill values (:mod:`floodsph.checks.elevation`),
    convert elevations in feet to metres;
-2. check the CRS: projected with metre units; a geographic DEM is reprojected (bilinear) to
-   the UTM zone of its centre on square cells of about its native size;
-3. crop to ``extent`` (whole cells);
+2. bring the grid to ground metres (:mod:`floodsph.io.crs`): a projected CRS in feet becomes
+   the same projection in metres (the coordinates scaled, no resampling); a geographic DEM, or
+   one whose CRS has a point scale factor beyond 1 +- 0.5 % anywhere in the domain (Web
+   Mercator away from the equator), is reprojected (bilinear) to the UTM zone of its centre on
+   square cells of about its native ground size;
+3. crop to ``extent`` (whole cells), given in the DEM file's CRS or ``coordinates_crs``;
 4. fill small interior holes (``rasterio.fill.fillnodata``); larger nodata areas are outside
    the model (``valid = False``) and get the nearest valid elevation so bed derivatives stay
    finite;
-5. Manning n on the same grid (:mod:`floodsph.io.manning`);
+5. Manning n on the same grid (:mod:`floodsph.io.manning`), taken from the nearest cell in
+   the filled holes where the roughness raster has none there;
 6. flip to row 0 = south and set the local origin to the lower-left corner of the grid.
 """
 
@@ -28,14 +33,23 @@ from rasterio.crs import CRS
 from rasterio.enums import Resampling
 from rasterio.fill import fillnodata
 from rasterio.transform import Affine
-from rasterio.warp import calculate_default_transform, reproject
+from rasterio.warp import calculate_default_transform, reproject, transform_bounds
 from scipy import ndimage
 
 from floodsph.checks.elevation import check_elevations, vertical_unit
 from floodsph.checks.roughness import N_DEFAULT
 from floodsph.errors import InputError, warn
+from floodsph.io.crs import (
+    SCALE_TOLERANCE,
+    centre_scale,
+    in_metres,
+    is_ground_metres,
+    length_unit,
+    scale_range,
+)
 from floodsph.io.manning import manning_grid
-from floodsph.io.raster import Grid, GridHeader, read_grid
+from floodsph.io.mosaic import read_dem_grid, tile_names
+from floodsph.io.raster import Grid, GridHeader, crs_label, parse_crs
 from floodsph.model.terrain import Terrain
 
 log = logging.getLogger(__name__)
@@ -57,6 +71,7 @@ def load_terrain(
     landcover=None,
     manning_table=None,
     extent=None,
+    coordinates_crs=None,
     fill_holes_max_cells: int = FILL_HOLES_MAX_CELLS,
     warnings: list[str] | None = None,
 ) -> Terrain:
@@ -64,8 +79,9 @@ def load_terrain(
 
     Parameters
     ----------
-    dem_path : str or Path
-        GeoTIFF, ESRI ASCII grid or NetCDF file of bed elevation [m].
+    dem_path : str, Path or tuple of Path
+        GeoTIFF, ESRI ASCII grid or NetCDF file of bed elevation [m], or a tuple of tiles
+        mosaicked into one grid (:mod:`floodsph.io.mosaic`).
     crs : str, optional
         CRS for a file that carries none (``"EPSG:27572"``).
     dem_variable : str, optional
@@ -76,8 +92,11 @@ def load_terrain(
         A land-cover class raster and a CSV ``class,manning_n`` (or ``"worldcover"``), used
         instead of ``manning``.
     extent : [xmin, ymin, xmax, ymax], optional
-        Crop window in the DEM's projected CRS [m] (after any reprojection); every cell
-        touching it is kept.
+        Crop window in the coordinates' CRS; every cell of the model grid touching it (its
+        bounds transformed into the model's CRS) is kept.
+    coordinates_crs : str or CRS, optional
+        The CRS of ``extent`` and of the scenario's inline coordinates (``[scenario] crs``,
+        kept as ``Terrain.coordinates_crs_wkt``); default: the DEM file's own CRS.
     fill_holes_max_cells : int
         Interior nodata regions of at most this many cells are filled by interpolation.
     warnings : list of str, optional
@@ -89,15 +108,17 @@ def load_terrain(
     Terrain
         Row 0 = south; ``x0, y0`` = world coordinates of the lower-left grid corner.
     """
-    path = Path(dem_path)
-    grid = read_grid(path, variable=dem_variable, crs=crs, what="DEM", warnings=warnings)
+    path = tile_names(dem_path) if isinstance(dem_path, tuple) else Path(dem_path)
+    grid = read_dem_grid(dem_path, variable=dem_variable, crs=crs, warnings=warnings)
     if not np.any(np.isfinite(grid.values)):
         raise InputError(f"DEM {path}: every cell is nodata")
     check_dem_size(grid.shape, path)
     grid = _elevations_in_metres(grid, path, warnings)
-    grid = _ensure_projected_metres(grid, path, warnings)
+    source_crs = grid.crs
+    user_crs = None if coordinates_crs is None else parse_crs(coordinates_crs, "scenario.crs")
+    grid, scales = _to_ground_metres(grid, path, warnings)
     if extent is not None:
-        grid = _crop(grid, extent, path)
+        grid = _crop(grid, _extent_in(extent, user_crs or source_crs, grid.crs), path)
     elevation, valid = _fill_nodata(grid.values, fill_holes_max_cells, path)
     n = manning_grid(
         grid.transform,
@@ -107,6 +128,7 @@ def load_terrain(
         manning=manning,
         landcover=landcover,
         manning_table=manning_table,
+        filled=valid & ~np.isfinite(grid.values),
         warnings=warnings,
     )
     rows = grid.shape[0]
@@ -120,6 +142,9 @@ def load_terrain(
         y0=t.f + t.e * rows,
         crs_wkt=grid.crs.to_wkt(),
         valid=valid[::-1].copy(),
+        source_crs_wkt=source_crs.to_wkt(),
+        source_scale=scales,
+        coordinates_crs_wkt=None if user_crs is None else user_crs.to_wkt(),
     )
 
 
@@ -159,8 +184,11 @@ def horizontal_crs(crs: CRS) -> CRS:
     return CRS.from_wkt(full.sub_crs_list[0].to_wkt())
 
 
-def _ensure_projected_metres(grid: Grid, path: Path, warnings=None) -> Grid:
-    """Accept a projected metre CRS; reproject a geographic one to UTM; refuse the rest."""
+def _to_ground_metres(grid: Grid, path: Path, warnings=None
+                      ) -> tuple[Grid, tuple[float, float] | None]:
+    """The grid in a projected CRS of ground metres, and the scale factor range found in the
+    file's CRS (None when geographic): feet converted, a geographic or distorting CRS
+    reprojected to UTM (:mod:`floodsph.io.crs`), each with a warning; other CRSs refused."""
     crs = grid.crs
     if crs is None:
         raise InputError(
@@ -168,14 +196,55 @@ def _ensure_projected_metres(grid: Grid, path: Path, warnings=None) -> Grid:
             '(e.g. crs = "EPSG:32632") or add a .prj file'
         )
     if crs.is_geographic:
-        return _reproject_to_utm(grid, path, warnings)
-    unit, factor = crs.linear_units_factor
-    if not crs.is_projected or not math.isclose(factor, 1.0):
+        cell = metric_cell_size(grid.transform, grid.shape)
+        utm = _reproject_to_utm(grid, cell)
+        warn(f"DEM {path} is in geographic coordinates ({crs_label(crs.to_wkt())}); "
+             f"reprojected to {crs_label(utm.crs.to_wkt())} with {cell:.3g} m square cells",
+             warnings)
+        return utm, None
+    if not crs.is_projected:
+        raise InputError(f"DEM {path}: the CRS must be projected or geographic, got "
+                         f"{crs.to_string()}; reproject the DEM first")
+    unit, metres = length_unit(crs)
+    if not math.isclose(metres, 1.0):
+        grid = _in_metres(grid, metres)
+        warn(f"DEM {path}: its CRS {crs_label(crs.to_wkt())} is in {unit} ({metres:.10g} m "
+             f"each); converted to the same projection in metres (cells of {grid.dx:.6g} m x "
+             f"{grid.dy:.6g} m)", warnings)
+    scales = scale_range(grid.crs, grid.transform, grid.shape)
+    if is_ground_metres(scales):
+        return grid, scales
+    k = centre_scale(grid.crs, grid.transform, grid.shape)
+    cell = float(f"{math.sqrt(grid.dx * grid.dy) / k:.3g}")
+    utm = _reproject_to_utm(grid, cell)
+    warn(f"DEM {path}: its CRS {crs_label(crs.to_wkt())} has a point scale factor of "
+         f"{scales[0]:.4f} to {scales[1]:.4f} over the domain ({k:.4f} at its centre), beyond "
+         f"1 +- {SCALE_TOLERANCE:.1%}: its lengths are not ground metres; reprojected to "
+         f"{crs_label(utm.crs.to_wkt())} with {cell:.3g} m square cells", warnings)
+    return utm, scales
+
+
+def _in_metres(grid: Grid, metres: float) -> Grid:
+    """A grid in a projected CRS of another length unit, in the same projection in metres:
+    the coordinates multiplied by the unit's length (exact, no resampling)."""
+    t = grid.transform
+    scaled = Affine(t.a * metres, 0.0, t.c * metres, 0.0, t.e * metres, t.f * metres)
+    return Grid(grid.values, scaled, in_metres(grid.crs), grid.units, grid.nodata)
+
+
+def _extent_in(extent, extent_crs, crs: CRS):
+    """``extent`` [xmin, ymin, xmax, ymax] given in ``extent_crs``, as bounds in ``crs`` (the
+    bounding box of its densified edges); unchanged when the two are the same CRS."""
+    try:
+        xmin, ymin, xmax, ymax = (float(v) for v in extent)
+    except (TypeError, ValueError):
         raise InputError(
-            f"DEM {path}: the CRS must be projected in metres, got {crs.to_string()} "
-            f"(units: {unit}); reproject the DEM first"
-        )
-    return grid
+            f"terrain.extent: expected [xmin, ymin, xmax, ymax], got {extent!r}"
+        ) from None
+    source = CRS.from_user_input(extent_crs)
+    if source == crs:
+        return extent
+    return list(transform_bounds(source, crs, xmin, ymin, xmax, ymax, densify_pts=21))
 
 
 def utm_crs_for(lon: float, lat: float) -> CRS:
@@ -234,23 +303,36 @@ class PlannedGrid:
         return self.rows * self.dy
 
 
-def planned_grid(header: GridHeader, extent=None) -> PlannedGrid:
+def planned_grid(header: GridHeader, extent=None, extent_crs=None) -> PlannedGrid:
     """The grid :func:`load_terrain` builds from a DEM, estimated from its header alone
     (before the values are read, for the memory estimate).
 
-    A geographic grid keeps about its rows and columns on cells of :func:`metric_cell_size`
-    (its ``extent``, in the UTM CRS, is not applied: errs high); a projected one is cut to
-    the cells of ``extent``.
+    A grid that will be reprojected (geographic, or a scale factor beyond the tolerance)
+    keeps about its rows and columns on square cells of its ground size, and one in feet its
+    rows and columns on cells in metres; neither is cut to ``extent`` (errs high). A grid
+    already in ground metres is cut to the cells of ``extent`` when that is in its own CRS
+    (``extent_crs`` None or the same).
     """
     rows, cols = header.shape
     t = header.transform
-    if header.crs is not None and header.crs.is_geographic:
+    crs = header.crs
+    if crs is not None and crs.is_geographic:
         cell = metric_cell_size(t, header.shape)
         return PlannedGrid(rows, cols, cell, cell)
-    if extent is not None:
+    if crs is None or not crs.is_projected:
+        return PlannedGrid(rows, cols, abs(t.a), abs(t.e))
+    _, metres = length_unit(crs)
+    dx, dy = abs(t.a) * metres, abs(t.e) * metres
+    if not math.isclose(metres, 1.0):
+        return PlannedGrid(rows, cols, dx, dy)
+    if not is_ground_metres(scale_range(crs, t, header.shape)):
+        cell = math.sqrt(dx * dy) / centre_scale(crs, t, header.shape)
+        return PlannedGrid(rows, cols, cell, cell)
+    same = extent_crs is None or CRS.from_user_input(extent_crs) == crs
+    if extent is not None and same:
         r0, r1, c0, c1 = _window(t, header.shape, extent)
         rows, cols = max(r1 - r0, 0), max(c1 - c0, 0)
-    return PlannedGrid(rows, cols, abs(t.a), abs(t.e))
+    return PlannedGrid(rows, cols, dx, dy)
 
 
 def _window(t: Affine, shape: tuple[int, int], extent) -> tuple[int, int, int, int]:
@@ -264,14 +346,16 @@ def _window(t: Affine, shape: tuple[int, int], extent) -> tuple[int, int, int, i
     return r0, r1, c0, c1
 
 
-def _reproject_to_utm(grid: Grid, path: Path, warnings=None) -> Grid:
-    """Bilinear reprojection of a geographic DEM to the UTM zone of its centre."""
+def _reproject_to_utm(grid: Grid, cell: float) -> Grid:
+    """Bilinear reprojection of a grid to the UTM zone of its centre on ``cell`` [m] squares."""
     rows, cols = grid.shape
     t = grid.transform
     west, north = t.c, t.f
     east, south = west + t.a * cols, north + t.e * rows
-    dst_crs = utm_crs_for(0.5 * (west + east), 0.5 * (south + north))
-    cell = metric_cell_size(t, grid.shape)
+    to_lonlat = pyproj.Transformer.from_crs(pyproj.CRS.from_wkt(grid.crs.to_wkt()),
+                                            "EPSG:4326", always_xy=True)
+    lon, lat = to_lonlat.transform(0.5 * (west + east), 0.5 * (south + north))
+    dst_crs = utm_crs_for(lon, lat)
     dst_t, w, h = calculate_default_transform(
         grid.crs, dst_crs, cols, rows, west, south, east, north, resolution=cell
     )
@@ -288,9 +372,6 @@ def _reproject_to_utm(grid: Grid, path: Path, warnings=None) -> Grid:
         resampling=Resampling.bilinear,
         tolerance=0.0,  # exact transformer, not GDAL's 0.125-pixel approximation
     )
-    name = dst_crs.to_wkt().split('"')[1]
-    warn(f"DEM {path} is in geographic coordinates ({grid.crs.to_string()}); reprojected to "
-         f"{name} (EPSG:{dst_crs.to_epsg()}) with {cell:.3g} m square cells", warnings)
     return Grid(out, dst_t, dst_crs)
 
 

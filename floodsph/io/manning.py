@@ -9,9 +9,12 @@ Forms (flood-practice.md §1.1, as in AutoRoutePy and HydroMT mapping tables):
   table. ``manning_table = "worldcover"`` selects the table shipped with floodsph for the
   ESA WorldCover classes (``floodsph/data/worldcover_manning.csv``, textbook values).
 
-Every valid DEM cell must end up with a finite n > 0, else one InputError; values that are
-Strickler or Chezy coefficients (n >= 1) are refused and unusually high ones (n > 0.2)
-warned of (:mod:`floodsph.checks.roughness`). Tables are UTF-8 CSV, with or without a BOM.
+Every valid DEM cell the DEM file holds must end up with a finite n > 0, else one InputError.
+Cells of the interior DEM holes that were filled by interpolation (``floodsph.io.dem``) take
+the n (or land-cover class) of the nearest cell that has one, with a warning giving the count:
+a roughness raster derived from the DEM has the DEM's holes. Values that are Strickler or Chezy
+coefficients (n >= 1) are refused and unusually high ones (n > 0.2) warned of
+(:mod:`floodsph.checks.roughness`). Tables are UTF-8 CSV, with or without a BOM.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import numpy as np
 from rasterio.crs import CRS
 from rasterio.enums import Resampling
 from rasterio.transform import Affine
+from scipy import ndimage
 
 from floodsph.checks.roughness import (
     N_DEFAULT,
@@ -33,7 +37,7 @@ from floodsph.checks.roughness import (
     check_manning_number,
     strickler_text,
 )
-from floodsph.errors import InputError
+from floodsph.errors import InputError, warn
 from floodsph.io.raster import resample_onto
 from floodsph.io.text import read_text
 
@@ -94,6 +98,7 @@ def manning_grid(
     manning=N_DEFAULT,
     landcover=None,
     manning_table=None,
+    filled: np.ndarray | None = None,
     warnings: list[str] | None = None,
 ) -> np.ndarray:
     """Manning's n [s m^-1/3] on a north-up DEM grid.
@@ -108,22 +113,30 @@ def manning_grid(
         Uniform n, or an n raster (bilinear).
     landcover, manning_table : path, optional
         Class raster (nearest) and its CSV table or ``"worldcover"``; replace ``manning``.
+    filled : (rows, cols) bool array, optional
+        DEM cells that were nodata in the file and were filled by interpolation; where the
+        roughness has no value there, it takes the nearest cell's (:func:`fill_from_nearest`).
     warnings : list of str, optional
-        Receives the warnings of n > 0.2 (:func:`floodsph.errors.warn`).
+        Receives the warnings of n > 0.2 and of the filled cells (:func:`floodsph.errors.warn`).
     """
+    if filled is None:
+        filled = np.zeros(shape, dtype=bool)
     if landcover is not None:
         if manning_table is None:
             raise InputError(
                 "terrain.landcover needs terrain.manning_table "
                 '(a CSV with columns class,manning_n, or "worldcover")'
             )
-        n = _from_landcover(transform, shape, crs, valid, landcover, manning_table)
+        n = _from_landcover(transform, shape, crs, valid, filled, landcover, manning_table,
+                            warnings)
         check_manning_grid(n, valid, f"landcover {landcover} with manning table "
                                      f"{manning_table}", warnings)
     elif isinstance(manning, (str, Path)):
         n = resample_onto(
             manning, transform, shape, crs, resampling=Resampling.bilinear, what="manning raster"
         )
+        n = fill_from_nearest(np.where(n > 0, n, np.nan), valid & filled,
+                              f"manning raster {manning}", warnings)
         bad = valid & ~(np.isfinite(n) & (n > 0))
         if bad.any():
             lo = np.nanmin(np.where(valid, n, np.nan)) if np.isfinite(n[valid]).any() else np.nan
@@ -147,12 +160,30 @@ def manning_grid(
     return np.where(valid, n, fallback)
 
 
-def _from_landcover(transform, shape, crs, valid, landcover, manning_table) -> np.ndarray:
+def fill_from_nearest(values: np.ndarray, filled: np.ndarray, what: str,
+                      warnings: list[str] | None) -> np.ndarray:
+    """Give the ``filled`` cells that have no value (NaN) the value of the nearest cell that
+    has one (Euclidean distance in cells, ``scipy.ndimage.distance_transform_edt``), and warn
+    with their count; other cells are returned as they are."""
+    missing = filled & ~np.isfinite(values)
+    if not missing.any() or not np.isfinite(values).any():
+        return values
+    _, (ri, ci) = ndimage.distance_transform_edt(~np.isfinite(values), return_indices=True)
+    out = values.copy()
+    out[missing] = values[ri[missing], ci[missing]]
+    warn(f"{what}: {int(missing.sum())} cells of the DEM's filled nodata holes have no value; "
+         "they take the value of the nearest cell that has one", warnings)
+    return out
+
+
+def _from_landcover(transform, shape, crs, valid, filled, landcover, manning_table,
+                    warnings) -> np.ndarray:
     """Map nearest-resampled land-cover classes through the class table."""
     table = read_manning_table(manning_table)
     classes = resample_onto(
         landcover, transform, shape, crs, resampling=Resampling.nearest, what="landcover"
     )
+    classes = fill_from_nearest(classes, valid & filled, f"landcover {landcover}", warnings)
     inside = classes[valid]
     if np.isnan(inside).any():
         raise InputError(

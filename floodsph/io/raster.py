@@ -8,6 +8,7 @@ returns it). Only :func:`floodsph.io.dem.load_terrain` flips to the solver's sou
 from __future__ import annotations
 
 import re
+import warnings as pywarnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -15,7 +16,7 @@ import numpy as np
 import rasterio
 from rasterio.crs import CRS
 from rasterio.enums import Resampling
-from rasterio.errors import CRSError, RasterioError
+from rasterio.errors import CRSError, NotGeoreferencedWarning, RasterioError
 from rasterio.transform import Affine
 from rasterio.warp import reproject
 
@@ -130,12 +131,13 @@ def read_grid(path, *, variable: str | None = None, crs=None, what: str = "raste
     Raises
     ------
     InputError
-        Missing/unreadable file, unknown NetCDF variable, rotated or sheared transform.
+        Missing/unreadable file, unknown NetCDF variable, a raster not georeferenced (identity
+        transform), rotated or sheared transform.
     """
     path = Path(path)
     name = _dataset(path, variable, what)
     try:
-        with rasterio.open(name) as src:
+        with _open(name) as src:
             _refuse_container(src, path, variable, what)
             values = src.read(1, out_dtype="float64")
             nodata = src.nodata
@@ -162,7 +164,7 @@ def read_header(path, *, variable: str | None = None, crs=None, what: str = "ras
     path = Path(path)
     name = _dataset(path, variable, what)
     try:
-        with rasterio.open(name) as src:
+        with _open(name) as src:
             _refuse_container(src, path, variable, what)
             shape, transform, file_crs = src.shape, src.transform, src.crs
     except RasterioError as exc:
@@ -174,6 +176,14 @@ def read_header(path, *, variable: str | None = None, crs=None, what: str = "ras
     own = _own_crs(file_crs, path)
     used = own if crs is None else parse_crs(crs, f"{what} {path}: crs")
     return GridHeader((int(rows), int(cols)), north_up, used)
+
+
+def _open(name: str):
+    """``rasterio.open`` without its NotGeoreferencedWarning: :func:`_check_axes` refuses such a
+    raster with a message that says what to do."""
+    with pywarnings.catch_warnings():
+        pywarnings.simplefilter("ignore", NotGeoreferencedWarning)
+        return rasterio.open(name)
 
 
 def _dataset(path: Path, variable: str | None, what: str) -> str:
@@ -205,7 +215,18 @@ def _own_crs(file_crs, path: Path):
 
 
 def _check_axes(t: Affine, path: Path, what: str) -> None:
-    """Refuse a rotated or sheared transform, or a zero cell size."""
+    """Refuse a raster that is not georeferenced (GDAL gives the identity transform, cells of
+    one unit from the origin, to a file whose coordinates it could not read: a NetCDF file
+    whose x and y carry no CF attributes, a bare GeoTIFF), a rotated or sheared transform, or
+    a zero cell size."""
+    if t.almost_equals(Affine.identity()):
+        raise InputError(
+            f"{what} {path}: the raster is not georeferenced (its transform is the identity: "
+            "cells of one unit from the origin); in a NetCDF file give the x and y variables "
+            'the CF attributes units ("m", or "degrees_east" / "degrees_north") and '
+            "standard_name (projection_x_coordinate / projection_y_coordinate, or longitude / "
+            "latitude), or convert it to a GeoTIFF with its transform"
+        )
     if t.b != 0.0 or t.d != 0.0:
         raise InputError(
             f"{what} {path}: the raster is rotated or sheared (transform {tuple(t)[:6]}); "

@@ -43,12 +43,12 @@ def _closed_edges(terrain) -> bool | tuple[str, ...]:
 
 
 def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
-    """The ``[[inflows]]`` sections and ``[[sinks]]`` polygons (``inputs.sinks``, inline or
-    from vector files) as model boundaries."""
+    """The ``[[inflows]]`` sections (``inputs.inflows``, in the terrain's CRS) and ``[[sinks]]``
+    polygons (``inputs.sinks``, inline or from vector files) as model boundaries."""
     terrain = inputs.terrain
     source = scenario.path.name
     out = []
-    for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,
+    for i, (inflow, hydrograph) in enumerate(zip(inputs.inflows, inputs.hydrographs,
                                                  strict=True)):
         line = np.column_stack(terrain.to_local(*np.asarray(inflow.line, dtype=np.float64).T))
         out.append(Inflow(line, hydrograph, numerics.particle_spacing_m, numerics.kappa, terrain,

@@ -44,6 +44,15 @@ class Terrain:
         The projected CRS as WKT; None for synthetic beds.
     valid : (ny, nx) bool array, optional
         False where the DEM had no data (outside the model). Defaults to all True.
+    source_crs_wkt : str or None
+        The CRS of the DEM file (or ``terrain.crs``) before any reprojection to ground
+        metres: the CRS inline coordinates are in by default. None: the same as ``crs_wkt``.
+    source_scale : (float, float) or None
+        The smallest and largest point scale factor of the DEM file's CRS over the domain
+        (``floodsph.io.crs``); None for a geographic DEM or a synthetic bed.
+    coordinates_crs_wkt : str or None
+        The CRS of the scenario's inline coordinates when ``[scenario] crs`` names one; None:
+        ``source_crs_wkt`` (``floodsph.inputs.coordinates``).
     """
 
     elevation: np.ndarray
@@ -54,6 +63,9 @@ class Terrain:
     y0: float = 0.0
     crs_wkt: str | None = None
     valid: np.ndarray | None = None
+    source_crs_wkt: str | None = None
+    source_scale: tuple[float, float] | None = None
+    coordinates_crs_wkt: str | None = None
     slope_x: np.ndarray = field(init=False, repr=False)
     slope_y: np.ndarray = field(init=False, repr=False)
     curv_xx: np.ndarray = field(init=False, repr=False)

@@ -17,8 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from floodsph.checks.placement import extent_text, lonlat_hint
+from floodsph.checks.placement import lonlat_hint, user_extent_text
 from floodsph.errors import InputError
+from floodsph.inputs.coordinates import to_model
 from floodsph.io.text import header_found, read_text
 from floodsph.output.grid import bilinear
 
@@ -39,7 +40,7 @@ class GaugePoints:
 
 def read_gauge_file(path, terrain) -> GaugePoints:
     """Read a UTF-8 CSV (a BOM allowed) with columns ``id, x, y`` (world coordinates in the
-    DEM CRS).
+    CRS of the inline coordinates, ``floodsph.inputs.coordinates``).
 
     Raises InputError naming the file and line for a file that is not UTF-8, a missing
     column, a non-numeric coordinate, a duplicate id or a point outside the DEM (saying so
@@ -59,11 +60,12 @@ def read_gauge_file(path, terrain) -> GaugePoints:
         except (TypeError, ValueError):
             raise InputError(f"{path}, line {line}: x and y must be numbers, got "
                              f"{row['x']!r}, {row['y']!r}") from None
-        lx, ly = x - terrain.x0, y - terrain.y0
+        mx, my = to_model(terrain, [(x, y)], f"{path}, line {line}")[0]
+        lx, ly = mx - terrain.x0, my - terrain.y0
         if not (0.0 <= lx <= terrain.width and 0.0 <= ly <= terrain.height):
             raise InputError(f"{path}, line {line}: gauge {row['id']!r} at ({x}, {y}) is "
-                             f"outside the DEM extent {extent_text(terrain)}"
-                             f"{lonlat_hint([(x, y)], terrain)}")
+                             f"outside the DEM extent {user_extent_text(terrain)}"
+                             f"{lonlat_hint([(mx, my)], terrain)}")
         if row["id"] in ids:
             raise InputError(f"{path}, line {line}: duplicate gauge id {row['id']!r}")
         ids.append(row["id"])

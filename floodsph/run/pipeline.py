@@ -114,6 +114,9 @@ class RunOptions:
 
 def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
     """The run proper, in the opened folder ``work``; see :func:`run_scenario`."""
+    from floodsph.inputs.coordinates import coordinates_wkt
+    from floodsph.io.raster import crs_label
+
     log_handler = attach_log(work / LOG_NAME, append=checkpoint is not None)
     manifest = new_manifest(scenario.to_dict())
     manifest.update(
@@ -123,6 +126,9 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
         volume_initial_m3=inputs.volume_initial_m3,
         max_steps=opts.max_steps,
         warnings=list(inputs.warnings),
+        crs=crs_label(inputs.terrain.crs_wkt),
+        dem_crs=crs_label(inputs.terrain.source_crs_wkt or inputs.terrain.crs_wkt),
+        coordinates_crs=crs_label(coordinates_wkt(inputs.terrain)),
         resumed_from=[] if checkpoint is None else [*checkpoint.resumed_from, checkpoint.t],
         checkpoint_time_s=None if checkpoint is None else checkpoint.t,
     )

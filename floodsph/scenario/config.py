@@ -43,23 +43,30 @@ class OutputFormat(Enum):
 @dataclass(frozen=True)
 class ScenarioInfo:
     """``[scenario]``: the name (also the default output folder), the simulated time [s] and
-    the calendar instant of its start (time zone aware, None when the scenario gives none)."""
+    the calendar instant of its start (time zone aware, None when the scenario gives none;
+    hydrograph dates count from it). ``crs`` is the CRS of the inline coordinates (polygons,
+    lines, extents) when they are not in the DEM file's own CRS
+    (``floodsph.inputs.coordinates``)."""
 
     name: str
     end_time_s: float
     description: str = ""
     start: datetime | None = None
+    crs: str | None = None
 
 
 @dataclass(frozen=True)
 class TerrainConfig:
     """``[terrain]``: the DEM and the bed roughness (a uniform n, an n raster or land cover).
 
+    ``dem`` is one file, or a tuple of tile files mosaicked into one grid
+    (``floodsph.io.mosaic``).
+
     ``manning`` is None when the roughness comes from ``landcover`` (+ ``manning_table``: a
     CSV path, or ``"worldcover"`` for the shipped ESA WorldCover table).
     """
 
-    dem: Path
+    dem: Path | tuple[Path, ...]
     crs: str | None = None
     dem_variable: str | None = None
     manning: float | Path | None = N_DEFAULT
@@ -211,7 +218,8 @@ class Scenario:
     def input_files(self) -> tuple[Path, ...]:
         """The scenario file and every file it reads (a run never writes over them)."""
         t = self.terrain
-        files = [self.path, t.dem, t.landcover,
+        tiles = t.dem if isinstance(t.dem, tuple) else (t.dem,)
+        files = [self.path, *tiles, t.landcover,
                  t.manning_table if isinstance(t.manning_table, Path) else None,
                  t.manning if isinstance(t.manning, Path) else None,
                  *(w.depth for w in self.initial_water),
@@ -232,10 +240,17 @@ class Scenario:
     def __repr__(self) -> str:
         return (
             f"Scenario({self.name!r}, end_time_s={self.end_time_s:g}, "
-            f"dem={self.terrain.dem.name!r}, "
+            f"dem={dem_label(self.terrain.dem)!r}, "
             f"initial_water={len(self.initial_water)}, walls={len(self.walls)}, "
             f"inflows={len(self.inflows)}, sinks={len(self.sinks)})"
         )
+
+
+def dem_label(dem) -> str:
+    """A DEM's file name, or ``a.tif + 3 tiles`` for a mosaic, for messages."""
+    if isinstance(dem, tuple):
+        return f"{dem[0].name} + {len(dem) - 1} tiles"
+    return dem.name
 
 
 def _plain(value):

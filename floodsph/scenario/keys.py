@@ -45,7 +45,8 @@ from floodsph.scenario.numerics import (
 )
 
 POINTS = "array of [x, y]"
-"""The type of a list of points in the DEM's CRS."""
+"""The type of a list of points in the inline coordinates' CRS (the DEM file's, or
+``[scenario] crs``)."""
 
 
 @dataclass(frozen=True)
@@ -128,7 +129,7 @@ def toml_text(value) -> str:
 VECTOR_KEYS = (
     KeyDoc("file", "path", "A vector file whose features stand for this entry, instead of "
            "inline coordinates: GeoJSON, or GeoPackage, shapefile or FlatGeobuf with the gis "
-           "extra; reprojected into the DEM's CRS (docs/vector-inputs.md).", absent="none"),
+           "extra; reprojected into the model's CRS (docs/vector-inputs.md).", absent="none"),
     KeyDoc("layer", "string", "With file: the layer of a file that holds several.",
            absent="the file's only layer"),
     KeyDoc("crs", "string", "With file: the CRS of its coordinates, for a file that carries "
@@ -147,17 +148,24 @@ SCENARIO = TableDoc("scenario", False, "What the scenario is called and how long
     KeyDoc("start", "date-time", "The calendar instant of t = 0, ISO 8601 with its time zone "
            "(`2024-01-15T06:00:00Z`, `2024-01-15T07:00:00+01:00`; a TOML date-time or a "
            "string). It dates the `time` of every NetCDF file (`seconds since` it, in UTC) "
-           "and adds the column `time_utc` to gauges.csv. A date-time without a time zone is "
+           "and adds the column `time_utc` to gauges.csv; hydrograph files with a `time` column "
+           "of dates count from it. A date-time without a time zone is "
            "refused.", absent="no calendar start: the NetCDF times count from "
            "1970-01-01T00:00:00Z, a placeholder with no meaning, and gauges.csv has no "
            "time_utc column"),
+    KeyDoc("crs", "string", "The CRS of the inline coordinates (polygons, lines, extent, the "
+           "gauges CSV) when they are not in the DEM file's own CRS (`EPSG:4326`, a WKT or "
+           "PROJ string). Vector files keep their own CRS.",
+           absent="the DEM file's CRS"),
 ))
 
 TERRAIN = TableDoc("terrain", False, "The ground: elevation, roughness and what happens at "
                    "the DEM's border.", TerrainConfig, required=True, keys=(
-    KeyDoc("dem", "path", "Digital elevation model: GeoTIFF, ESRI ASCII grid (.asc, with .prj) or "
-           "NetCDF (see dem_variable). A geographic DEM is reprojected to its UTM zone.", "m",
-           required=True),
+    KeyDoc("dem", "path or array of paths", "Digital elevation model: GeoTIFF, ESRI ASCII grid "
+           "(.asc, with .prj), NetCDF (see dem_variable) or a GDAL VRT; a list of tiles or a glob "
+           "(`tiles/N36W08*.tif`) is mosaicked. A geographic DEM, or one whose CRS departs from "
+           "ground metres by more than 0.5 % (Web Mercator), is reprojected to its UTM zone; a "
+           "CRS in feet becomes the same projection in metres.", "m", required=True),
     KeyDoc("crs", "string", "CRS of the DEM (`EPSG:27572`, a WKT or PROJ string), for a file "
            "that carries none, such as a bare .asc.", absent="the DEM file's CRS"),
     KeyDoc("dem_variable", "string", "Variable of a NetCDF DEM that holds the elevation.",
@@ -170,8 +178,8 @@ TERRAIN = TableDoc("terrain", False, "The ground: elevation, roughness and what 
     KeyDoc("manning_table", "path", "CSV with columns class, manning_n (extra columns ignored) "
            "for landcover, or \"worldcover\" for the table shipped for ESA WorldCover classes; "
            "required with landcover."),
-    KeyDoc("extent", "[xmin, ymin, xmax, ymax]", "Crop of the DEM, in its CRS.", "m",
-           absent="the whole DEM"),
+    KeyDoc("extent", "[xmin, ymin, xmax, ymax]", "Crop of the DEM, in the DEM file's CRS (or "
+           "scenario.crs).", absent="the whole DEM"),
     KeyDoc("edges", "string", "`open`: water that crosses the DEM border, or reaches nodata, "
            "leaves and is counted as outflow (waves pass out without reflection); `closed`: the "
            "border and the nodata cells are walls.", choices=Edges),
@@ -184,7 +192,8 @@ INITIAL_WATER = TableDoc("initial_water", True, "Water present at t = 0 (a reser
     KeyDoc("level_m", "number", "Free-surface elevation: the polygon is filled wherever the bed "
            "lies below it. Needs polygon.", "m", absent="none (give level_m + polygon or depth)"),
     KeyDoc("polygon", POINTS, "The area to fill to level_m (at least three points, not crossing "
-           "itself), in the DEM's CRS.", "m", absent="none (give polygon or file with level_m)"),
+           "itself), in the DEM file's CRS (or scenario.crs).", "m",
+           absent="none (give polygon or file with level_m)"),
     KeyDoc("depth", "path", "Instead of level_m + polygon: a raster of initial depth.", "m",
            absent="none"),
     *VECTOR_KEYS,
@@ -192,7 +201,8 @@ INITIAL_WATER = TableDoc("initial_water", True, "Water present at t = 0 (a reser
 
 WALLS = TableDoc("walls", True, "Lines water cannot cross (embankments, flood walls, "
                  "buildings).", Wall, keys=(
-    KeyDoc("polyline", POINTS, "The wall's vertices in the DEM's CRS; a closed polyline (first "
+    KeyDoc("polyline", POINTS, "The wall's vertices, in the DEM file's CRS (or scenario.crs); "
+           "a closed polyline (first "
            "point = last) is a solid footprint such as a building.", "m",
            absent="none (give polyline or file)"),
     *VECTOR_KEYS,
@@ -202,8 +212,10 @@ INFLOWS = TableDoc("inflows", True, "A breach section where water enters the mod
                    "hydrograph or a parametric breach.", Inflow, keys=(
     KeyDoc("line", POINTS, "The section's two end points; water enters across it.", "m",
            required=True),
-    KeyDoc("hydrograph", "path", "CSV with columns time_s, discharge_m3s: the total discharge "
-           "through the section. Give this or [inflows.breach].", absent="none"),
+    KeyDoc("hydrograph", "path", "CSV of the total discharge through the section: time as "
+           "time_s, time_min or time_h, or time as ISO 8601 dates (counted from scenario.start, "
+           "else from the first row); discharge as discharge_m3s or discharge_cfs. Give this "
+           "or [inflows.breach].", absent="none"),
     KeyDoc("breach", "table", "A parametric breach turned into the hydrograph "
            "(see [inflows.breach]).", absent="none"),
     KeyDoc("direction", "[dx, dy]", "Direction of the entering flow (any length but zero).",
@@ -231,8 +243,8 @@ BREACH = TableDoc("inflows.breach", False, "A parametric dam breach (Froehlich 2
            "invert).", "m2", absent="V_w / h_w"),
     KeyDoc("storage_table", "path", "Instead of reservoir_area_m2: a CSV of elevation_m with "
            "volume_m3 or area_m2 (interpolated linearly).", absent="none"),
-    KeyDoc("inflow_hydrograph", "path", "Inflow into the reservoir during the breach, CSV "
-           "time_s, discharge_m3s.", absent="none"),
+    KeyDoc("inflow_hydrograph", "path", "Inflow into the reservoir during the breach, a CSV "
+           "as inflows.hydrograph (dates count from its first row).", absent="none"),
     KeyDoc("progression", "string", "How the breach grows over the formation time: `linear` or "
            "`sine`."),
     KeyDoc("weir_coefficient", "number", "C_w of the breach weir (side parts 2.45 / 3.1 C_w).",
@@ -257,7 +269,8 @@ SINKS = TableDoc("sinks", True, "Areas where water leaves the model (the sea, a 
 
 GAUGES = TableDoc("gauges", False, "Time series of depth, level and speed at points "
                   "(written to gauges.csv).", Gauges, keys=(
-    KeyDoc("file", "path", "CSV with columns id, x, y (the DEM's CRS), or a vector file of "
+    KeyDoc("file", "path", "CSV with columns id, x, y (the DEM file's CRS, or scenario.crs), "
+           "or a vector file of "
            "points (docs/vector-inputs.md).", required=True),
     KeyDoc("interval_s", "number", "Simulated time between two samples (> 0).", "s"),
     KeyDoc("layer", "string", "With a vector file: the layer of a file that holds several.",

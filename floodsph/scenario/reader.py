@@ -86,16 +86,23 @@ def scenario_from_dict(data: dict, *, source: str, base_dir: Path) -> Scenario:
 def _info(r: Reader, data: dict) -> ScenarioInfo:
     if "scenario" not in data:
         raise r.fail("scenario", "required table [scenario] is missing")
-    t = r.sub_table(data, "", "scenario", ("name", "end_time_s", "description", "start"))
+    t = r.sub_table(data, "", "scenario",
+                    ("name", "end_time_s", "description", "start", "crs"))
     name = r.string(t, "scenario", "name")
     problem = name_problem(name)
     if problem is not None:
         raise r.fail("scenario.name", problem)
+    crs = r.string(t, "scenario", "crs", None)
+    if crs is not None:
+        from floodsph.io.raster import parse_crs
+
+        parse_crs(crs, f"{r.source}: scenario.crs")
     return ScenarioInfo(
         name=name,
         end_time_s=r.number(t, "scenario", "end_time_s", gt=0.0),
         description=r.string(t, "scenario", "description", ""),
         start=r.instant(t, "scenario", "start"),
+        crs=crs,
     )
 
 
@@ -154,7 +161,7 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         manning = None
     edges = r.choice(t, p, "edges", Edges, TerrainConfig.edges)
     return TerrainConfig(
-        dem=r.existing_file(t, p, "dem"),
+        dem=_dem(r, t, p),
         crs=r.string(t, p, "crs", None),
         dem_variable=r.string(t, p, "dem_variable", None),
         manning=manning,
@@ -164,6 +171,30 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         edges=edges,
         closed_sides=_closed_sides(r, t, p, edges),
     )
+
+
+def _dem(r: Reader, t: dict, p: str) -> Path | tuple[Path, ...]:
+    """``terrain.dem``: one file, a list of tile files, or a glob pattern (``*``, ``?``,
+    ``[...]``) of tiles, relative to the scenario's folder; several files are a tuple in the
+    order given (a glob's in sorted order), one file a path."""
+    where = join(p, "dem")
+    if "dem" not in t:
+        raise r.fail(where, "required key is missing")
+    value = t["dem"]
+    if isinstance(value, list):
+        if not value or not all(isinstance(v, str) for v in value):
+            raise r.fail(where, f"expected a path or a list of paths, got {describe(value)}")
+        files = tuple(r.file_value(v, join(where, i)) for i, v in enumerate(value))
+    elif isinstance(value, str) and any(c in value for c in "*?["):
+        pattern = r.resolve(value, where)
+        files = tuple(sorted(f for f in pattern.parent.glob(pattern.name) if f.is_file()))
+        if not files:
+            raise r.fail(where, f"no file matches {pattern}")
+    else:
+        return r.existing_file(t, p, "dem")
+    if len(set(files)) != len(files):
+        raise r.fail(where, "a tile is named twice")
+    return files[0] if len(files) == 1 else files
 
 
 def _manning_table(r: Reader, t: dict, p: str) -> Path | str | None:

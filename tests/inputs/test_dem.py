@@ -77,16 +77,16 @@ def test_south_up_raster_is_flipped(tmp_path):
 
 def test_asc_with_prj(tmp_path):
     z = ramp()
-    path = write_asc(tmp_path / "dem.asc", z, 1000.0, 2000.0, 20.0)
+    path = write_asc(tmp_path / "dem.asc", z, 957_000.0, 1_844_000.0, 20.0)  # Malpasset
     (tmp_path / "dem.prj").write_text(CRS.from_epsg(27572).to_wkt())
     ter = load_terrain(path)
     assert CRS.from_wkt(ter.crs_wkt).to_epsg() == 27572
-    assert (ter.x0, ter.y0, ter.dx) == (1000.0, 2000.0, 20.0)
+    assert (ter.x0, ter.y0, ter.dx) == (957_000.0, 1_844_000.0, 20.0)
     np.testing.assert_allclose(ter.elevation, z[::-1], atol=1e-3)
 
 
 def test_asc_with_crs_argument_and_without_crs(tmp_path):
-    path = write_asc(tmp_path / "bare.asc", ramp(), 0.0, 0.0, 5.0)
+    path = write_asc(tmp_path / "bare.asc", ramp(), 957_000.0, 1_844_000.0, 5.0)
     ter = load_terrain(path, crs="EPSG:27572")
     assert CRS.from_wkt(ter.crs_wkt).to_epsg() == 27572
     with pytest.raises(InputError, match="bare.asc has no coordinate reference system"):
@@ -126,6 +126,36 @@ def test_netcdf_variable(tmp_path):
         load_terrain(path)
     with pytest.raises(InputError, match=r"dem\.nc.*'nosuch'"):
         load_terrain(path, dem_variable="nosuch")
+
+
+def test_netcdf_without_cf_coordinates_refused(tmp_path):
+    # x and y hold the coordinates but carry no units / standard_name: GDAL reads the pixel
+    # grid (the identity transform), with the grid mapping's CRS.
+    xr = pytest.importorskip("xarray")
+    x = 600_000.0 + 10.0 * (np.arange(12) + 0.5)
+    y = 4_000_000.0 + 10.0 * (np.arange(8) + 0.5)
+    ds = xr.Dataset(
+        {"bed": (("y", "x"), np.full((8, 12), 50.0), {"grid_mapping": "crs"}),
+         "crs": xr.DataArray(0, attrs={"crs_wkt": CRS.from_string(UTM32).to_wkt()})},
+        coords={"x": ("x", x), "y": ("y", y)},
+    )
+    ds.to_netcdf(tmp_path / "bare.nc")
+    with pytest.raises(InputError, match=r"bare.nc: the raster is not georeferenced.*units.*"
+                                         r"standard_name.*GeoTIFF"):
+        load_terrain(tmp_path / "bare.nc", dem_variable="bed")
+
+
+def test_geotiff_without_transform_refused(tmp_path):
+    path = tmp_path / "pixels.tif"
+    with rasterio.open(path, "w", driver="GTiff", width=5, height=5, count=1,
+                       dtype="float32", crs=UTM32) as dst:
+        dst.write(np.full((5, 5), 10.0, dtype=np.float32), 1)
+    with pytest.raises(InputError, match="pixels.tif: the raster is not georeferenced"):
+        load_terrain(path)
+    from floodsph.io.raster import read_header
+
+    with pytest.raises(InputError, match="pixels.tif: the raster is not georeferenced"):
+        read_header(path, what="DEM")
 
 
 def test_geographic_dem_reprojected_to_utm(tmp_path, caplog):
@@ -197,10 +227,25 @@ def test_corrupt_file_names_the_file(tmp_path):
         load_terrain(tmp_path / "missing.tif")
 
 
-def test_non_metre_projected_crs_refused(tmp_path):
-    path = write_tif(tmp_path / "feet.tif", ramp(), from_origin(0, 80, 10, 10), "EPSG:2229")
-    with pytest.raises(InputError, match="feet.tif: the CRS must be projected in metres"):
-        load_terrain(path)
+def test_state_plane_in_feet_becomes_the_same_projection_in_metres(tmp_path):
+    # NAD83 / North Carolina (ftUS), 10 ft cells near Raleigh; elevations in metres.
+    x_ft, y_ft = 2_100_000.0, 740_000.0
+    z = ramp()
+    path = write_tif(tmp_path / "feet.tif", z, from_origin(x_ft, y_ft, 10, 10), "EPSG:2264")
+    warnings = []
+    ter = load_terrain(path, warnings=warnings)
+    us_foot = 1200.0 / 3937.0
+    crs = CRS.from_wkt(ter.crs_wkt)
+    assert crs.linear_units_factor == ("metre", 1.0)
+    assert ter.dx == pytest.approx(10.0 * us_foot, rel=1e-12)
+    # The grid corner is the same point on the ground in both CRSs.
+    x_m, y_m = warp_transform(CRS.from_epsg(2264), crs, [x_ft], [y_ft - 8 * 10.0])
+    assert (ter.x0, ter.y0) == pytest.approx((x_m[0], y_m[0]), abs=1e-6)
+    assert ter.x0 == pytest.approx(x_ft * us_foot, abs=1e-6)
+    np.testing.assert_array_equal(ter.elevation, z[::-1].astype(np.float32))  # not resampled
+    assert [w for w in warnings if "feet.tif" in w and "US survey foot" in w
+            and "converted to the same projection in metres" in w]
+    assert ter.source_scale == pytest.approx((1.0, 1.0), abs=1e-3)
 
 
 def test_extent_crop_to_whole_cells(tmp_path):
@@ -247,3 +292,32 @@ def test_utm_zone_choice():
     assert utm_crs_for(20.0, 89.0).to_epsg() == 32634
     # Bergen lies in the regular zone 31 (the military grid's zone 32V is not an EPSG area).
     assert utm_crs_for(5.32, 60.39).to_epsg() == 32631
+
+
+def test_web_mercator_dem_is_reprojected_to_ground_metres(tmp_path):
+    # 100 x 100 cells of 20 m in EPSG:3857 at 36.7 N: 1 / cos(36.7 deg) = 1.247, so the
+    # cells are 16.0 m on the ground.
+    merc = CRS.from_epsg(3857)
+    x0, y0 = warp_transform(CRS.from_epsg(4326), merc, [-87.0], [36.7])
+    z = np.full((100, 100), 200.0)
+    path = write_tif(tmp_path / "merc.tif", z, from_origin(x0[0], y0[0], 20.0, 20.0), "EPSG:3857")
+    warnings = []
+    ter = load_terrain(path, warnings=warnings)
+    assert CRS.from_wkt(ter.crs_wkt).to_epsg() == 32616
+    assert ter.dx == ter.dy == 16.0
+    lo, hi = ter.source_scale
+    assert 1.245 < lo < hi < 1.250
+    assert [w for w in warnings if "merc.tif" in w and "EPSG:3857" in w and "1.247" in w
+            and "EPSG:32616" in w and "16 m square cells" in w]
+    # The area with data is the true ground area: (2000 m / 1.247)^2, within a row of cells.
+    area = ter.valid.sum() * ter.dx * ter.dy
+    assert area == pytest.approx((2000.0 / 1.2472) ** 2, rel=0.03)
+
+
+def test_web_mercator_near_the_equator_is_kept(tmp_path):
+    # At 2 N the scale factor is 1.0006: within 0.5 %, the DEM is used as it is.
+    path = write_tif(tmp_path / "eq.tif", ramp(), from_origin(0.0, 222_000.0, 20.0, 20.0),
+                     "EPSG:3857")
+    ter = load_terrain(path)
+    assert CRS.from_wkt(ter.crs_wkt).to_epsg() == 3857 and ter.dx == 20.0
+    assert ter.source_scale[1] == pytest.approx(1.0006, abs=1e-4)

@@ -102,3 +102,49 @@ def test_shipped_worldcover_table():
     table = read_manning_table(worldcover_table_path())
     assert sorted(table) == [10, 20, 30, 40, 50, 60, 70, 80, 90, 95, 100]
     assert table[10] == 0.12 and table[30] == 0.035 and table[60] == 0.025
+
+
+def holed(tmp_path):
+    """A 20 x 20 DEM with a 3 x 3 interior nodata hole (filled by interpolation), and the
+    north-up rows/columns of that hole."""
+    z = np.full((20, 20), 100.0)
+    z[8:11, 5:8] = -9999.0
+    return write(tmp_path / "holed.tif", z, from_origin(X0, Y_TOP, 10, 10)), (8, 11, 5, 8)
+
+
+def test_raster_masked_like_the_dem_follows_its_filled_holes(tmp_path):
+    dem, (r0, r1, c0, c1) = holed(tmp_path)
+    # n derived from the DEM: the same hole; west of column 6 n = 0.03, east 0.06.
+    n = np.where(np.arange(20)[None, :] < 6, 0.03, 0.06) * np.ones((20, 1))
+    n[r0:r1, c0:c1] = -9999.0
+    warnings = []
+    ter = load_terrain(dem, manning=write(tmp_path / "n.tif", n, from_origin(X0, Y_TOP, 10, 10)),
+                       warnings=warnings)
+    assert [w for w in warnings if "9 cells of the DEM's filled nodata holes" in w]
+    hole = ter.manning[::-1][r0:r1, c0:c1]  # north-up again
+    # Nearest cell with a value: column 5 -> column 4 (0.03), column 7 -> column 8 (0.06).
+    np.testing.assert_allclose(hole[:, 0], 0.03)
+    np.testing.assert_allclose(hole[:, 2], 0.06)
+
+
+def test_raster_missing_over_dem_data_still_refused(tmp_path):
+    dem, (r0, r1, c0, c1) = holed(tmp_path)
+    n = np.full((20, 20), 0.04)
+    n[r0:r1, c0:c1] = -9999.0
+    n[2, 2] = -9999.0  # the DEM file holds this cell: refused
+    path = write(tmp_path / "n.tif", n, from_origin(X0, Y_TOP, 10, 10))
+    with pytest.raises(InputError, match=r"n.tif: 1 DEM cells get no value"):
+        load_terrain(dem, manning=path)
+
+
+def test_landcover_masked_like_the_dem_follows_its_filled_holes(tmp_path):
+    dem, (r0, r1, c0, c1) = holed(tmp_path)
+    classes = np.full((20, 20), 10)  # WorldCover tree cover
+    classes[r0:r1, c0:c1] = 0
+    path = write(tmp_path / "lc.tif", classes, from_origin(X0, Y_TOP, 10, 10), dtype="uint8",
+                 nodata=0)
+    warnings = []
+    ter = load_terrain(dem, landcover=path, manning_table="worldcover", warnings=warnings)
+    assert [w for w in warnings if "lc.tif: 9 cells" in w]
+    tree = ter.manning[0, 0]
+    np.testing.assert_allclose(ter.manning[::-1][r0:r1, c0:c1], tree)

@@ -126,8 +126,9 @@ def test_inflow_line_off_the_dem(write_scenario, tmp_path):
     path = write_scenario(BASE_SCENARIO + inflow)
     assert_input_error(
         invoke("check", path),
-        f"scenario.toml: inflows[0].line: point [{X0 + 150:g}, {Y0 + 900:g}] is outside the DEM "
-        f"extent [{X0:g}, {Y0:g}, {X0 + 400:g}, {Y0 + 200:g}]",
+        f"scenario.toml: inflows[0].line: point [{X0 + 150:.10g}, {Y0 + 900:.10g}] is outside "
+        f"the DEM extent [{X0:.10g}, {Y0:.10g}, {X0 + 400:.10g}, {Y0 + 200:.10g}] in "
+        "EPSG:32632 (WGS 84 / UTM zone 32N), the DEM file's CRS",
     )
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import BASE_SCENARIO, X0, Y0
 
@@ -206,6 +207,40 @@ def test_a_bad_hydrograph_is_refused_with_the_inputs_naming_file_key_and_line(wr
     assert message.startswith(f"scenario.toml: inflows[0].hydrograph: {tmp_path / 'q.csv'}, "
                               "line 4: ")
     assert "times must increase strictly" in message
+
+
+def test_hydrograph_dates_count_from_scenario_start_and_check_names_the_units(write_scenario,
+                                                                               tmp_path):
+    from floodsph.inputs.prepare import prepare_inputs, summary_lines
+
+    # 20 m3/s from 06:10 to 06:20 local time (UTC+2): 04:10-04:20 UTC, from a 04:00 UTC start.
+    (tmp_path / "q.csv").write_text("time,discharge_cfs\n2024-05-01T06:10+02:00,706.2933\n"
+                                    "2024-05-01T06:20+02:00,706.2933\n")
+    text = BASE_SCENARIO.replace("end_time_s = 20.0", "end_time_s = 1000.0\n"
+                                 "start = 2024-05-01T04:00:00Z")
+    text += f"[[inflows]]\nline = [[{X0 + 5}, {Y0 + 5}], [{X0 + 5}, {Y0 + 55}]]\n" \
+        'hydrograph = "q.csv"\n'
+    scenario = load_scenario(write_scenario(text))
+    assert scenario.start.isoformat() == "2024-05-01T04:00:00+00:00"
+    inputs = prepare_inputs(scenario)
+    np.testing.assert_allclose(inputs.hydrographs[0].t, [600.0, 1200.0])
+    assert inputs.volume_inflow_m3 == pytest.approx(20.0 * 400.0, rel=1e-6)  # 600 -> 1000 s
+    lines = summary_lines(scenario, inputs, None)
+    assert [line for line in lines if line.startswith("Converted:") and "q.csv" in line
+            and "scenario.start (2024-05-01T04:00:00+00:00)" in line
+            and "cubic feet per second" in line]
+    # The same instant as a string, with its offset.
+    again = text.replace("start = 2024-05-01T04:00:00Z", 'start = "2024-05-01T06:00:00+02:00"')
+    assert again != text
+    assert load_scenario(write_scenario(again)).start == scenario.start
+    write_resolved(scenario, tmp_path / "resolved.toml")  # and back from the run folder's copy
+    assert load_scenario(tmp_path / "resolved.toml").start == scenario.start
+
+
+def test_a_start_that_is_no_instant_names_the_key(write_scenario):
+    text = BASE_SCENARIO.replace("end_time_s = 20.0", 'end_time_s = 20.0\nstart = "May 1st"')
+    assert error_of(write_scenario, text).endswith(
+        "scenario.start: 'May 1st' is not an ISO 8601 date-time such as 2024-01-15T06:00:00Z")
 
 
 def test_refinement_thresholds_reach_the_refiner(write_scenario):
