@@ -119,8 +119,11 @@ class Probe:
                                                              "h")}
         speed = np.hypot(p.u, p.v)
         case = self.case
-        level = (np.abs(model.depth() + model.bed[: p.n, 0] - case.level_m)
-                 if case.level_m is not None and p.n else np.array([math.nan]))
+        eta = model.surface_levels()
+        if eta is None:  # the variational momentum: the summed depth on the bed
+            eta = model.depth() + model.bed[: p.n, 0]
+        level = (np.abs(eta - case.level_m) if case.level_m is not None and p.n
+                 else np.array([math.nan]))
         x, y = terrain.to_world(p.x, p.y)
         self.samples.append(Sample(
             t=float(model.t), particles=int(p.n),
@@ -138,7 +141,7 @@ class Probe:
 
         p = model.particles
         d = rasterise(OutputGrid.from_terrain(model.terrain), p.x, p.y, p.u, p.v, p.m, p.rho,
-                      p.h)[0][::-1]  # north-up, as the reservoir mask
+                      p.h, level=model.surface_levels())[0][::-1]  # north-up, as the mask
         wet = np.nan_to_num(d) > self.wet_threshold
         return int(np.count_nonzero(wet & ~self.case.reservoir))
 
@@ -521,7 +524,8 @@ def machine_note(bench: Benchmark) -> str:
 
 MEASURES = (
     "* Speeds are the particles' |v|; the level error is max |d + b - L| over the particles "
-    "(d the SPH depth, b the bed under the particle, L the lake's level), `level p95` its "
+    "(d the SPH depth, b the bed under the particle, L the lake's level; under the balanced "
+    "momentum the particle's level eta = d + b + o), `level p95` its "
     "95th percentile.",
     "* Bowl: the shore error is the largest |r_out - r_s| over 36 sectors, r_out the "
     "outermost particle of a sector, r_s the exact shoreline.",

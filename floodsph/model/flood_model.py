@@ -143,8 +143,24 @@ class FloodModel:
 
     # -- state -----------------------------------------------------------------------------
     def depth(self) -> np.ndarray:
-        """Depth d = rho / rho_w [m] of the active particles."""
-        return self.particles.rho / RHO_WATER
+        """Depth [m] of the active particles: d = rho / rho_w, and under the balanced momentum
+        d + o, its level less the bed (``floodsph.sph.level_offsets``)."""
+        p = self.particles
+        if self.balanced:
+            return p.rho / RHO_WATER + p.eta_offset
+        return p.rho / RHO_WATER
+
+    def surface_levels(self) -> np.ndarray | None:
+        """The free-surface levels eta = d + b + o [m] of the particles under the balanced
+        momentum (``floodsph.sph.level_offsets``), which the maps and gauges report depth
+        from; None under the variational momentum (they report the summed depth)."""
+        if not self.balanced:
+            return None
+        p = self.particles
+        t = self.terrain
+        eta = np.empty(p.n)
+        level_offsets.levels(p.x, p.y, p.rho, p.eta_offset, t.elevation, t.dx, t.dy, eta)
+        return eta
 
     def volume(self) -> float:
         """Water volume in the domain, sum m / rho_w [m3]."""
@@ -400,9 +416,28 @@ class FloodModel:
         bedmod.sample_bed(rows, p.x, p.y, t.dx, t.dy, *t.bed_grids(), self.bed)
         if self._blocked_nl is not self.nl:  # the density loop rebuilt the lists last
             self.block_pairs()
-        if self.balanced:
-            self._balanced_forces(rows)
+        if not self.balanced:
+            self._variational_forces(rows)
             return
+        weight = level_momentum.variational_weight(p.u[rows], p.v[rows])
+        moving = rows[weight > 0.0]
+        if moving.size:
+            self._variational_forces(moving)
+            a_var = np.stack([p.ax[moving], p.ay[moving], p.divv[moving]])
+        slow = rows[weight < 1.0]
+        if slow.size:
+            self._balanced_forces(slow)
+        if moving.size:
+            w = weight[weight > 0.0]
+            for field, value in zip((p.ax, p.ay, p.divv), a_var, strict=True):
+                field[moving] = w * value + (1.0 - w) * field[moving]
+
+    def _variational_forces(self, rows: np.ndarray) -> None:
+        """The variational momentum's accelerations of the particles ``rows``
+        (``floodsph.sph.forces``, renormalised by ``floodsph.sph.consistency``, balanced at
+        shores by ``floodsph.sph.shore``, and the bed)."""
+        p = self.particles
+        t = self.terrain
         if self.scheme == forces.MUSCL:
             velocity_gradient(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, self.nl.start,
                               self.nl.nbr, self.blocked, p.dudx, p.dudy, p.dvdx, p.dvdy)

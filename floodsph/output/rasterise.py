@@ -99,19 +99,20 @@ def accumulate_sums(px, py, x, y, h, vol, d, u, v, cell_start, order, xmin, ymin
         sums[k, 3] += s3
 
 
-def kernel_sums(px, py, x, y, u, v, m, rho, h) -> np.ndarray:
-    """(n_points, 4) array of sum_j V_j W times (1, d_j, u_j, v_j) at the points [-, m, m/s]."""
+def kernel_sums(px, py, x, y, u, v, m, rho, h, level=None) -> np.ndarray:
+    """(n_points, 4) array of sum_j V_j W times (1, d_j, u_j, v_j) at the points [-, m, m/s];
+    with ``level`` the particles' levels eta_j [m] take the place of d_j."""
     px = np.ascontiguousarray(px, dtype=np.float64)
     py = np.ascontiguousarray(py, dtype=np.float64)
     sums = np.zeros((px.shape[0], 4), dtype=np.float64)
     if x.shape[0] == 0 or px.shape[0] == 0:
         return sums
     vol = m / rho
-    d = rho / RHO_WATER
-    level = np.empty(x.shape[0], dtype=np.int64)
-    lv_hmax, box = h_levels(x, y, h, LEVEL_BASE * float(np.median(h)), level)
+    d = rho / RHO_WATER if level is None else level
+    h_level = np.empty(x.shape[0], dtype=np.int64)
+    lv_hmax, box = h_levels(x, y, h, LEVEL_BASE * float(np.median(h)), h_level)
     for lv in np.flatnonzero(lv_hmax > 0.0):
-        group = level == lv
+        group = h_level == lv
         gx, gy, gh = x[group], y[group], h[group]
         grid = CellGrid(gx, gy, 2.0 * float(lv_hmax[lv]), tuple(box[lv]))
         k = np.flatnonzero(_reached(px, py, grid))
@@ -137,8 +138,14 @@ def _reached(px, py, grid: CellGrid) -> np.ndarray:
     return out
 
 
-def interpolate(px, py, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT):
+def interpolate(px, py, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT, level=None,
+                bed=None):
     """Shepard SPH depth d [m] and velocity (u, v) [m/s] at points (px, py) (local metres).
+
+    With the particles' free-surface levels ``level`` [m] (the balanced momentum's,
+    ``floodsph.model.flood_model.FloodModel.surface_levels``) and the bed ``bed`` [m] at the
+    points, the depth is the Shepard level less the bed, max(eta(x) - b(x), 0): a lake at
+    rest then maps at its level exactly, where the summed depth would show its smoothing.
 
     Parameters
     ----------
@@ -154,23 +161,33 @@ def interpolate(px, py, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT)
     -------
     d, u, v, support : float64 arrays shaped like ``px``; NaN where unsupported.
     """
-    sums = kernel_sums(np.ravel(px), np.ravel(py), x, y, u, v, m, rho, h)
-    return _shepard(sums, min_support, np.shape(px))
+    sums = kernel_sums(np.ravel(px), np.ravel(py), x, y, u, v, m, rho, h, level)
+    d, u, v, support = _shepard(sums, min_support, np.shape(px))
+    return _depth_below(d, level, bed), u, v, support
 
 
-def rasterise(grid, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT):
+def rasterise(grid, x, y, u, v, m, rho, h, min_support: float = MIN_SUPPORT, level=None):
     """Depth d [m] and velocity (u, v) [m/s] on an :class:`OutputGrid` (row 0 = south).
 
-    The values of :func:`interpolate` at the cell centres, summed by :func:`grid_sums`;
-    returns ``(d, u, v, support)``, each ``grid.shape``.
+    The values of :func:`interpolate` at the cell centres (with ``level``, less the grid's
+    bed), summed by :func:`grid_sums`; returns ``(d, u, v, support)``, each ``grid.shape``.
     """
     xc, yc = grid.cell_centres()
     sums = np.zeros((yc.shape[0], xc.shape[0], 4), dtype=np.float64)
     if x.shape[0]:
         band_start, band_items = band_lists(yc, y, h, BAND_ROWS)
-        grid_sums(xc, yc, x, y, h, m / rho, rho / RHO_WATER, u, v, band_start, band_items,
-                  BAND_ROWS, numba.get_num_threads(), sums)
-    return _shepard(sums.reshape(-1, 4), min_support, grid.shape)
+        grid_sums(xc, yc, x, y, h, m / rho, rho / RHO_WATER if level is None else level, u, v,
+                  band_start, band_items, BAND_ROWS, numba.get_num_threads(), sums)
+    d, u, v, support = _shepard(sums.reshape(-1, 4), min_support, grid.shape)
+    return _depth_below(d, level, None if level is None else grid.bed), u, v, support
+
+
+def _depth_below(d, level, bed):
+    """The mapped depth [m]: ``d`` as it is, or with levels, the Shepard level ``d`` less the
+    bed, never below 0 (NaN stays NaN)."""
+    if level is None:
+        return d
+    return np.where(np.isnan(d), np.nan, np.maximum(d - bed, 0.0))
 
 
 def _shepard(sums, min_support: float, shape):

@@ -323,9 +323,9 @@ NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are 
     KeyDoc("momentum", "string", "The pressure and bed forces: `variational` (default), the "
            "variational force on the summation depth with the bed pointwise; `balanced`, the "
            "free-surface level's renormalised differences, which hold a lake at rest exactly "
-           "by walls, nodata banks and shores (docs/balanced-momentum.md; its dam-break "
-           "fronts lag). Takes stabilisation = \"lax-friedrichs\" and wall_model = "
-           "\"mirror\".", choices=Momentum),
+           "by walls, nodata banks and shores, with the variational force for water faster "
+           "than 0.1 m/s (docs/balanced-momentum.md). Takes stabilisation = "
+           "\"lax-friedrichs\" and wall_model = \"mirror\".", choices=Momentum),
 ))
 
 OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into it.",

@@ -89,7 +89,8 @@ class Recorders:
         from floodsph.output.rasterise import rasterise
 
         p = sim.model.particles
-        d, u, v, _ = rasterise(self.grid, p.x, p.y, p.u, p.v, p.m, p.rho, p.h)
+        d, u, v, _ = rasterise(self.grid, p.x, p.y, p.u, p.v, p.m, p.rho, p.h,
+                               level=sim.model.surface_levels())
         self.snapshots.append(sim.model.t, d, u, v)
 
     def write(self, into: Path) -> list[Path]:
