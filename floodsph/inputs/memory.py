@@ -31,14 +31,15 @@ Bytes, at the larger of the two peaks (seeding, then the run)::
   neighbours x 8 B (240 B): 640 B;
 * OUTPUT = cells_out * 12 * 8: ~12 float64 envelope maps (max depth, speed, ..., arrival,
   duration);
-* ``BASE_BYTES`` = 500 MiB: the interpreter with numpy, numba, rasterio, xarray, netCDF4 and
-  matplotlib imported and the kernels loaded or compiled. Measured peak resident memory
-  (``getrusage`` ``ru_maxrss``) of a whole run of a 200-particle valley, where the base is
-  all there is: 418 MiB with the kernels in numba's cache, 649 MiB when they compile (LLVM's
-  working memory: the first run after an install). 500 MiB is within 25 % of both. On the
-  sample (``data_samples/valley``, 9,300 particles at peak, cached kernels) the estimate is
-  514 MiB against a peak of 454 MiB (+13 %); on Malpasset (``workflows/malpasset``, the sea
-  as particles, 17,900 at peak, one thread) 581 MiB against 612 MiB (-5 %; it was -30 %).
+* ``BASE_BYTES`` = 420 MiB: the interpreter with numpy, numba, rasterio, xarray, netCDF4 and
+  matplotlib imported and the kernels loaded from numba's cache, plus ``COMPILE_BYTES`` =
+  240 MiB when the cache holds no kernel yet (:func:`kernels_cached`: LLVM's working memory
+  on the first run after an install). Measured peak resident memory (``getrusage``
+  ``ru_maxrss``) of a whole run of a 200-particle valley, where the base is all there is:
+  399-418 MiB with the kernels cached, 649 MiB when they compile. On the sample
+  (``data_samples/valley``, 9,300 particles at peak, cached kernels) the peak is 454 MiB; on
+  Malpasset (``workflows/malpasset``, the sea as particles, 17,900 at peak, one thread)
+  612 MiB.
 
 Every count comes from shapes and areas known before the arrays exist (``floodsph.inputs.prepare``
 estimates before reading the DEM, and again before seeding), so a run too large is refused
@@ -57,7 +58,8 @@ BYTES_PER_PARTICLE = 2 * 13 * 8 + 24 * 8 + 30 * 8
 OUTPUT_MAPS = 12
 DEM_GRIDS = 8
 SEEDING_ARRAYS = 14
-BASE_BYTES = 500 * 2**20
+BASE_BYTES = 420 * 2**20
+COMPILE_BYTES = 240 * 2**20
 COUNT_LIMIT = 1.0e24
 
 #: Environment variable that overrides the available memory [bytes] (used by tests).
@@ -118,12 +120,13 @@ def estimate_memory(
     *,
     read_cells: float | None = None,
     lattice_cells: float = 0.0,
+    compiling: bool = False,
 ) -> MemoryEstimate:
     """Estimate the peak memory of a run (formula in the module docstring).
 
     ``n_initial`` may be an estimate (wet area / spacing^2, before seeding); ``read_cells``
     is the size of the rasters as read (default ``dem_cells``), ``lattice_cells`` that of the
-    seeding lattice.
+    seeding lattice; ``compiling``: the kernels will compile (``COMPILE_BYTES`` more).
     """
     n_inflow = inflow_volume_m3 / D_TYPICAL_M / spacing_m / spacing_m
     n_peak = _count((n_initial + n_inflow) * REFINEMENT_FACTOR[refinement]) + 1
@@ -134,7 +137,21 @@ def estimate_memory(
         output_bytes=_count(output_cells) * OUTPUT_MAPS * 8,
         dem_bytes=(dem * (DEM_GRIDS - 1) + read) * 8,
         seeding_bytes=_count(lattice_cells) * SEEDING_ARRAYS * 8,
+        base_bytes=BASE_BYTES + (COMPILE_BYTES if compiling else 0),
     )
+
+
+def kernels_cached() -> bool:
+    """True if numba's cache holds the force kernel (an index file of
+    ``floodsph.sph.forces.internal_acceleration``, in ``NUMBA_CACHE_DIR`` when it is set, else
+    beside the module): the run loads its kernels instead of compiling them."""
+    from pathlib import Path
+
+    pattern = "forces.internal_acceleration*.nbi"
+    root = os.environ.get("NUMBA_CACHE_DIR")
+    if root:
+        return any(Path(root).rglob(pattern))
+    return any((Path(__file__).resolve().parents[1] / "sph" / "__pycache__").glob(pattern))
 
 
 def available_memory() -> tuple[int | None, str]:

@@ -39,7 +39,13 @@ from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
 from floodsph.inputs.coordinates import inline_to_model
-from floodsph.inputs.memory import MemoryEstimate, check_memory, estimate_memory, format_bytes
+from floodsph.inputs.memory import (
+    MemoryEstimate,
+    check_memory,
+    estimate_memory,
+    format_bytes,
+    kernels_cached,
+)
 from floodsph.inputs.run_time import estimate_run_time, run_threads, warn_if_huge
 from floodsph.inputs.vectors import vector_gauges, with_vector_geometry
 from floodsph.io.raster import crs_label
@@ -182,7 +188,8 @@ def lattice_cells(width: float, height: float, spacing: float) -> float:
 def _estimate(scenario, n_initial, v_in, spacing, dem_cells, out_cells, lattice,
               read_cells=None) -> MemoryEstimate:
     return estimate_memory(n_initial, v_in, spacing, scenario.numerics.refinement.value,
-                           dem_cells, out_cells, read_cells=read_cells, lattice_cells=lattice)
+                           dem_cells, out_cells, read_cells=read_cells, lattice_cells=lattice,
+                           compiling=not kernels_cached())
 
 
 def cells_read(scenario: Scenario) -> float:

@@ -64,10 +64,14 @@ def reservoir_file(folder: Path) -> str:
 def test_the_estimate_is_within_a_quarter_of_the_measured_peak(write_scenario, tmp_path,
                                                                 geometry, kernels):
     """"compiled": an empty numba cache, so the kernels compile as on a first run (a minute)
-    and LLVM's working memory adds to the peak; the estimate was 46 % low there."""
+    and LLVM's working memory adds to the peak, which the estimate counts then; "cached":
+    after a first run of the same scenario."""
     text = BASE_SCENARIO if geometry == "inline" else reservoir_file(tmp_path)
     env = {"NUMBA_CACHE_DIR": str(tmp_path / "numba")} if kernels == "compiled" else None
-    result = measure(write_scenario(text), tmp_path / "run", env)
+    scenario = write_scenario(text)
+    if kernels == "cached":  # a first run fills the cache (kernels edited since compile)
+        measure(scenario, tmp_path / "warm-up")
+    result = measure(scenario, tmp_path / "run", env)
     assert result["status"] == "completed"
     assert abs(result["estimate"] - result["peak"]) <= 0.25 * result["peak"], result
 
