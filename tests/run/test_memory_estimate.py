@@ -1,7 +1,9 @@
 """The peak-memory estimate against the peak resident memory a run really takes.
 
 Each run goes in a fresh interpreter (a subprocess), which reports its own peak resident set
-size (``getrusage``'s ``ru_maxrss``) beside the estimate that ``floodsph check`` prints
+size (``VmHWM`` of ``/proc/self/status``: the high-water mark of the process's own memory
+since it started; ``getrusage``'s ``ru_maxrss`` would carry the test process's peak over
+the fork) beside the estimate that ``floodsph check`` prints
 (``floodsph.inputs.memory``). The estimate must lie within 25 % of the measured peak: the
 conftest valley with the reservoir inline and drawn in a GeoJSON file, with the kernels from
 numba's cache and compiled afresh, and, with ``-m slow``,
@@ -19,12 +21,13 @@ from pathlib import Path
 import pytest
 from conftest import BASE_SCENARIO, CELL, NY, X0, Y0
 
-resource = pytest.importorskip("resource")  # getrusage: POSIX only
+pytestmark = pytest.mark.skipif(not Path("/proc/self/status").exists(),
+                                reason="the peak resident memory is read from /proc (Linux)")
 
 SAMPLE = Path(__file__).resolve().parents[2] / "data_samples" / "valley" / "scenario.toml"
 
 MEASURE = """
-import json, resource, sys
+import json, sys
 from floodsph.inputs.prepare import prepare_inputs
 from floodsph.run.pipeline import run_scenario
 from floodsph.scenario.reader import load_scenario
@@ -32,7 +35,8 @@ from floodsph.scenario.reader import load_scenario
 scenario = load_scenario(sys.argv[1])
 estimate = prepare_inputs(scenario).memory.total
 run = run_scenario(scenario, sys.argv[2], progress=False)
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kB on Linux
+with open("/proc/self/status") as status:
+    peak = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmHWM:"))
 print(json.dumps({"estimate": estimate, "peak": peak, "status": run["status"]}))
 """
 
