@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from floodsph.constants import RHO_WATER
+from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.model.local_stepping import big_step
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
@@ -473,8 +473,8 @@ class FloodModel:
                                              self.blocked, self.wall_lists(), t.elevation,
                                              self.held, t.dx, t.dy, p.ax, p.ay, p.divv,
                                              self.ghost)
-        level_momentum.add_bed_normal(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
-                                      p.ay)
+        forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
+                                    p.ay, 0.0, -GRAVITY)
 
     def match_levels(self) -> int:
         """Give every particle seeded at rest the level offset that makes its level its seeded

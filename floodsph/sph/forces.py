@@ -388,12 +388,16 @@ def _reflect(kxx, kxy, kyy, nx, ny):
 
 
 @njit(parallel=True, cache=True)
-def add_bed_acceleration(rows, u, v, bed, max_slope, ax, ay):
-    """Add the bed term of (5) to the internal accelerations of the particles ``rows``.
+def add_bed_acceleration(rows, u, v, bed, max_slope, ax, ay, g_bed=GRAVITY, floor=0.0):
+    """Add the bed term of (5) to the internal accelerations of the particles ``rows``:
+
+        a_i <- a_i - max([(g_bed + v.K.v + a_i . grad b) / (1 + |grad b|^2)], floor) grad b.
 
     ``bed`` is the (n, 7) sample of ``floodsph.sph.bed.sample_bed``. The slope is limited to
-    ``max_slope`` in magnitude, and the normal-force factor to >= 0 (a column cannot be pulled
-    into the bed).
+    ``max_slope`` in magnitude. The variational force takes g_bed = g and floor = 0 (a
+    column cannot be pulled into the bed); the balanced momentum, whose a_i already holds
+    -g grad b through the level, takes only the normal-force part, g_bed = 0 and floor = -g
+    (``floodsph.sph.level_momentum``; zero at rest).
     """
     for k in prange(rows.shape[0]):
         i = rows[k]
@@ -405,7 +409,7 @@ def add_bed_acceleration(rows, u, v, bed, max_slope, ax, ay):
             by *= max_slope / s
         vkv = (u[i] * (bed[i, CURV_XX] * u[i] + bed[i, CURV_XY] * v[i])
                + v[i] * (bed[i, CURV_XY] * u[i] + bed[i, CURV_YY] * v[i]))
-        f = (GRAVITY + vkv + ax[i] * bx + ay[i] * by) / (1.0 + bx * bx + by * by)
-        f = max(f, 0.0)
+        f = (g_bed + vkv + ax[i] * bx + ay[i] * by) / (1.0 + bx * bx + by * by)
+        f = max(f, floor)
         ax[i] -= f * bx
         ay[i] -= f * by

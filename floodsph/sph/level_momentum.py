@@ -48,8 +48,9 @@ antisymmetric). The velocity divergence for the continuity guess of the depth is
 ``floodsph.sph.forces``, div v_i = -(2 / alpha_i) sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i).
 
 The bed enters only through the normal-force part of the bed term of Rodriguez-Paz & Bonet
-(2005), :func:`add_bed_normal` (zero at rest). Momentum is conserved only to the gradient's
-consistency: a difference form cannot be both exact for a level and antisymmetric.
+(2005): ``floodsph.sph.forces.add_bed_acceleration`` with g_bed = 0 (zero at rest).
+Momentum is conserved only to the gradient's consistency: a difference form cannot be both
+exact for a level and antisymmetric.
 
 Moving water. The level form's free edges push only the outermost row of a dry front, and a
 front that thins into a train of equally deep particles then coasts (Ritter at 10 m: L1 7.9 %
@@ -68,7 +69,7 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
-from floodsph.sph.bed import BED, CURV_XX, CURV_XY, CURV_YY, SLOPE_X, SLOPE_Y, elevation_at
+from floodsph.sph.bed import BED, elevation_at
 from floodsph.sph.kernels import dwdr_over_r_cubic, w_cubic
 from floodsph.walls.geometry import mirror
 from floodsph.walls.images import moving_image
@@ -319,26 +320,3 @@ def variational_weight(u, v):
     1); a = lambda a_variational + (1 - lambda) a_balanced."""
     s = np.minimum(np.hypot(u, v) / BLEND_SPEED, 1.0)
     return s * s * (3.0 - 2.0 * s)
-
-
-@njit(parallel=True, cache=True)
-def add_bed_normal(rows, u, v, bed, max_slope, ax, ay):
-    """The normal-force part of the bed term (Rodriguez-Paz & Bonet 2005) for a = -g grad eta:
-
-        a_i <- a_i - [(v.K.v + a_i . grad b) / (1 + |grad b|^2)] grad b,
-
-    K the bed's curvature, the slope limited to ``max_slope``, the factor kept >= -g (a
-    column is not pulled into the bed). Zero at rest."""
-    for k in prange(rows.shape[0]):
-        i = rows[k]
-        bx = bed[i, SLOPE_X]
-        by = bed[i, SLOPE_Y]
-        s = math.sqrt(bx * bx + by * by)
-        if s > max_slope:
-            bx *= max_slope / s
-            by *= max_slope / s
-        vkv = (u[i] * (bed[i, CURV_XX] * u[i] + bed[i, CURV_XY] * v[i])
-               + v[i] * (bed[i, CURV_XY] * u[i] + bed[i, CURV_YY] * v[i]))
-        f = max((vkv + ax[i] * bx + ay[i] * by) / (1.0 + bx * bx + by * by), -GRAVITY)
-        ax[i] -= f * bx
-        ay[i] -= f * by
