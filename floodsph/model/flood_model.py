@@ -217,10 +217,12 @@ class FloodModel:
 
     def move(self, dt: float) -> None:
         """Drift every particle by dt (walls reflect), let the open boundaries act, drop what
-        left the domain, and advance density and h by the continuity guess."""
+        left the domain, and advance density and h by the continuity guess. Under the balanced
+        momentum the level offsets of moving water fade with the distance travelled
+        (``floodsph.sph.level_offsets``)."""
         p = self.particles
         if self.balanced:
-            level_offsets.decay_offsets(p.u, p.v, p.h, dt, p.eta_offset)
+            level_offsets.decay_offsets(p.u, p.v, p.h, dt, p.bank_held, p.eta_offset)
         self.counters["wall_reflections"] += int(sight.drift(
             p.x, p.y, p.u, p.v, dt, self.walls_near.wstart, self.walls_near.wseg, self.seg))
         self._nl_here = False
@@ -381,16 +383,22 @@ class FloodModel:
         guess, so the lists are rebuilt and the solve repeated until they hold (at most
         ``SETTLE_ROUNDS``); lists of some rows alone (the set-up's settling of wall seeds)
         hold while they cover those rows, as the other particles do not change then.
+        Under the balanced momentum, still water held by its banks keeps its continuity
+        depth, and water just released from it has its offset matched
+        (``floodsph.sph.level_offsets``).
         """
         num = self.numerics
         p = self.particles
         h_predicted = p.h.copy()
+        rho_predicted = p.rho.copy() if self.balanced else None
+        held = p.bank_held == level_offsets.HELD if self.balanced else None
         for _ in range(SETTLE_ROUNDS if settle else 2):
             self.block_pairs()
             outcome = density.solve_density(
                 p, self.nl, self.blocked, self.wall_lists(),
                 tol=num.density_tol, max_iter=num.density_max_iter, h_ratio=num.h_ratio,
-                cap=not settle, integral=self.integral_walls, unmoved=self._nl_here)
+                cap=not settle, integral=self.integral_walls, unmoved=self._nl_here,
+                skip=held)
             if settle and self.nl.covers(p.x, p.y, p.h):
                 break
             if not settle and (outcome.capped == 0 or self.lists_fresh):
@@ -402,6 +410,8 @@ class FloodModel:
             p.hgrow[:] = p.h / h_predicted
         else:
             p.hgrow[rows] = p.h[rows] / h_predicted[rows]
+        if self.balanced:
+            level_offsets.release(p.bank_held, rho_predicted, p.rho, p.eta_offset)
         self.counters["density_unconverged"] += outcome.unconverged
         self.counters["density_capped"] += outcome.capped
         self.counters["density_held"] += outcome.held
@@ -471,20 +481,32 @@ class FloodModel:
         level_momentum.balanced_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                              self.eta, self.bed, self.nl.start, self.nl.nbr,
                                              self.blocked, self.wall_lists(), t.elevation,
-                                             self.held, t.dx, t.dy, p.ax, p.ay, p.divv,
-                                             self.ghost)
+                                             self.held, p.bank_held, p.eta_seed, t.dx, t.dy,
+                                             p.ax, p.ay, p.divv, self.ghost)
+        held = rows[p.bank_held[rows] == level_offsets.HELD]
+        moved = ((p.u[held] ** 2 + p.v[held] ** 2 >= level_momentum.EDGE_SPEED ** 2)
+                 | (np.abs(self.eta[held] - p.eta_seed[held]) >= level_momentum.HOLD_LEVEL))
+        p.bank_held[held[moved]] = level_offsets.RELEASED
         forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
                                     p.ay, 0.0, -GRAVITY)
 
     def match_levels(self) -> int:
         """Give every particle seeded at rest the level offset that makes its level its seeded
-        level (``floodsph.sph.level_offsets.match_offsets``), and evaluate the forces again;
-        returns the number matched. For the set-up, under the balanced momentum."""
+        level (``floodsph.sph.level_offsets.match_offsets``), evaluate the forces again, and
+        mark as held by its banks each particle seeded at rest that has no free edge then
+        (``ParticleSet.bank_held``, ``floodsph.sph.level_momentum``); returns the number
+        matched. For the set-up, under the balanced momentum."""
         p = self.particles
         t = self.terrain
         bed = np.empty(p.n)
         level_offsets.levels(p.x, p.y, np.zeros(p.n), np.zeros(p.n), t.elevation, t.dx, t.dy,
                              bed)
         matched = level_offsets.match_offsets(p.eta_seed, p.rho, bed, p.eta_offset)
+        p.bank_held[:] = level_offsets.FREE
         self.interactions()
+        free_edge = np.zeros(p.n, dtype=bool)
+        evaluated = min(p.n, self.ghost.shape[0])  # no ghost array when all water moves
+        free_edge[:evaluated] = self.ghost[:evaluated] > 0.0
+        at_rest = np.isfinite(p.eta_seed) & (p.u == 0.0) & (p.v == 0.0)
+        p.bank_held[:] = np.where(at_rest & ~free_edge, level_offsets.HELD, level_offsets.FREE)
         return matched

@@ -42,6 +42,8 @@ FIELDS: dict[str, tuple[type, str]] = {
                                "(floodsph.sph.level_offsets)"),
     "eta_seed": (np.float64, "m, the level a particle seeded at rest was seeded at "
                              "(NaN for water seeded moving, injected or born in the run)"),
+    "bank_held": (np.int64, "1 for water seeded at rest whose support had no free edge at "
+                            "set-up: it keeps none until it moves (floodsph.sph.level_momentum)"),
     "pid": (np.int64, "unique particle id, never reused"),
 }
 
@@ -78,6 +80,14 @@ class ParticleSet:
             return data[name][: self.n]
         raise AttributeError(name)
 
+    def __setattr__(self, name: str, value) -> None:
+        """``p.u = values`` and ``p.u += du`` write into the active particles' array (an
+        attribute of that name would hide the field from every later reallocation)."""
+        if name in FIELDS:
+            self._data[name][: self.n] = value
+        else:
+            super().__setattr__(name, value)
+
     def __len__(self) -> int:
         return self.n
 
@@ -98,7 +108,7 @@ class ParticleSet:
 
         ``u, v`` default to 0, ``h0``/``rho0`` to the given ``h``/``rho``, ``alpha`` to
         2 rho (its lattice value), ``hgrow`` to 1, ``level``, ``born``, ``stride`` and
-        ``eta_offset`` to 0, ``eta_seed`` to NaN.
+        ``eta_offset`` and ``bank_held`` to 0, ``eta_seed`` to NaN.
         New ids are assigned.
         Returns the slice of the new particles.
         """
@@ -128,6 +138,7 @@ class ParticleSet:
             "stride": 0,
             "eta_offset": 0.0,
             "eta_seed": np.nan,
+            "bank_held": 0,
         }
         start = self.n
         self._reserve(start + count)

@@ -34,9 +34,9 @@ from floodsph.run.atomic_files import atomic_path
 from floodsph.run.folder import CHECKPOINT_DIR
 
 STATE_NAME = "state.pkl"
-FORMAT = 3
+FORMAT = 4
 """Checkpoint layout; 2 adds the particles' velocity gradient, 3 their level offset and seeded
-level (``floodsph.model.particles``)."""
+level, 4 their flag of still water held by its banks (``floodsph.model.particles``)."""
 _TERRAIN = "terrain"
 
 

@@ -234,7 +234,7 @@ def predict(rho, h, divv, dt):
 
 
 def solve_density(p, nl, blocked, walls, tol=1e-3, max_iter=20, h_ratio=10.0, cap=False,
-                  integral=False, unmoved=False):
+                  integral=False, unmoved=False, skip=None):
     """Solve (1)-(3) in place for the particles of ``p`` that ``nl`` lists (``nl.rows``).
 
     ``p`` is the ParticleSet (its rho and h hold the initial guess); ``nl`` the NeighbourList;
@@ -245,11 +245,14 @@ def solve_density(p, nl, blocked, walls, tol=1e-3, max_iter=20, h_ratio=10.0, ca
     guess (see the module docstring); ``unmoved``: the particles are where ``nl`` was built.
     On return every particle has rho, h and alpha consistent with its neighbours to ``tol``,
     except the unconverged, capped and held ones, which take the plain summation at their h.
+    ``skip``: a mask of particles left out, whose rho and h stay as they come (the balanced
+    momentum's still water, ``floodsph.sph.level_offsets``).
     Returns the :class:`DensityOutcome` counts.
     """
     iters = np.ones(p.n, dtype=np.int64)  # rows not solved count as converged
     h_cap = nl.h_cap(p.x, p.y, unmoved) if cap else np.full(p.n, np.inf)
-    solve(nl.rows, p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked,
+    rows = nl.rows if skip is None else nl.rows[~skip[nl.rows]]
+    solve(rows, p.x, p.y, p.m, p.rho, p.h, p.h0, p.rho0, p.alpha, nl.start, nl.nbr, blocked,
           walls, tol, max_iter, h_ratio, h_cap, H_SHRINK_MIN if cap else 0.0, integral, iters)
     return DensityOutcome(*_outcome(iters, max_iter))
 

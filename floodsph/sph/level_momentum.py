@@ -39,6 +39,27 @@ particle (whose own Shepard sum stays near 1 even at a front):
     4. the bed at x_i + 2 h_i e^ lies below eta_i + (v_i . e^)_+^2 / 2g: a still shore on
        rising ground holds its water.
 
+Still water held by its banks. Tests 2 and 3 look at points and DEM cells that move with the
+particle, so a lake at rest disturbed by a micrometre could switch its banks' ghosts on and
+off (a Malpasset reservoir disturbed by 1e-6 m/s reached 3 m/s within 20 s, a shore
+particle's ghost switched on in the first step). Water seeded at rest whose support had no
+free edge at set-up therefore keeps none while it stays slower than ``EDGE_SPEED``
+(``bank_held`` = ``floodsph.sph.level_offsets.HELD``, set by
+``floodsph.model.flood_model.FloodModel.match_levels`` and released for good once the
+particle reaches that speed, or its level departs from its seeded level by ``HOLD_LEVEL``):
+its banks were tested once, on the seeded lake. Where its support is cut (|e_i| h_i >=
+``EDGE_MIN``), the missing part is a bank standing at the lake's level: a ghost of level
+L_i, the seeded level, adds (L_i - eta_i) e_i to S_i and completes N_i as the dry ghost does.
+It is zero at rest, and pushes a particle whose level fell back among its neighbours.
+
+Held water is also damped, a_i -= v_i / ``HOLD_TIME``. Measured on the Malpasset reservoir
+disturbed by 1e-6 m/s, with the bank ghost and the held water's continuity depth and fixed
+offset (``floodsph.sph.level_offsets``) but without the damping, a few particles in pockets
+of the nodata border still grew e-fold every 11 s: a one-sided support whose particle moves
+away from its neighbours expands, its level falls and the level difference pushes it further.
+The damping's rate, 0.5 s-1, is five times that growth, and it acts only below 1 cm/s and
+within 1 cm of the seeded level, where a lake is at rest.
+
 The ghost's depth: d* = eta_i - b_g where the bed beyond is level or falls (b_g <= b_i), else
 the hydrostatic reconstruction min(max(eta_i + run-up - b_g, 0), d_i) (Audusse et al. 2004,
 SIAM J. Sci. Comput. 25, 2050-2065), b_g the bed at x_i + l e^.
@@ -71,6 +92,7 @@ from numba import njit, prange
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.bed import BED, elevation_at
 from floodsph.sph.kernels import dwdr_over_r_cubic, w_cubic
+from floodsph.sph.level_offsets import HELD
 from floodsph.walls.geometry import mirror
 from floodsph.walls.images import moving_image
 from floodsph.walls.sight import SIGHT_SLACK, hides
@@ -89,6 +111,12 @@ COVER_MIN = 0.6
 """Shepard sum at x_g [-] at and above which there is water there (no ghost)."""
 BLEND_SPEED = 0.1
 """Speed [m s-1] from which water takes the variational force alone (:func:`variational_weight`)."""
+HOLD_TIME = 2.0
+"""Relaxation time [s] of the linear damping a = -v / HOLD_TIME of still water held by its
+banks (module docstring)."""
+HOLD_LEVEL = 0.01
+"""Departure [m] of a held particle's level from its seeded level at which it is released
+(module docstring)."""
 EDGE_SPEED = 0.01
 """Speed [m s-1] from which a particle's cut support is a free edge without the Shepard-sum
 test (test 2): moving water's rows behind a front need the push."""
@@ -241,13 +269,16 @@ def ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x, 
 
 @njit(parallel=True, cache=True)
 def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, nbr, blocked,
-                          walls, elevation, held, tdx, tdy, ax, ay, divv, ghost):
+                          walls, elevation, held, bank_held, eta_seed, tdx, tdy, ax, ay, divv,
+                          ghost):
     """a_i = -g N_i^-1 S_i + shock capturing, and div v_i, of the particles ``rows`` (gather
     form; module docstring), with the neighbour lists, blocked pairs and
     :class:`~floodsph.walls.index.WallLists` of ``floodsph.sph.forces.internal_acceleration``;
     ``eta`` [m] the particles' levels, ``bed`` their bed sample (``floodsph.sph.bed``),
     ``elevation`` the terrain's node grid of spacing (tdx, tdy) [m] and ``held`` its cells
-    that held water at seeding or are nodata (test 4); ``ghost`` receives each
+    that held water at seeding or are nodata (test 3), ``bank_held`` the particles' flags of
+    still water held by its banks and ``eta_seed`` [m] their seeded levels (module
+    docstring); ``ghost`` receives each
     particle's ghost depth d* [m] (0: no free edge)."""
     seg, wdist, wstart, wseg, cstart, cpair = walls
     for k in prange(rows.shape[0]):
@@ -295,8 +326,20 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         sy = acc[3]
         ex = -acc[7]
         ey = -acc[8]
-        d_ghost = ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x,
-                              y, m, rho, h, wstart, wseg, seg, elevation, held, tdx, tdy)
+        if bank_held[i] == HELD:
+            d_ghost = 0.0
+            e = math.sqrt(ex * ex + ey * ey)
+            if e * hi >= EDGE_MIN:  # the bank: a ghost at the lake's level
+                reach = GHOST_REACH * hi
+                sx += (eta_seed[i] - eta[i]) * ex
+                sy += (eta_seed[i] - eta[i]) * ey
+                nxx += reach * ex * ex / e
+                nxy += reach * ex * ey / e
+                nyy += reach * ey * ey / e
+        else:
+            d_ghost = ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked,
+                                  x, y, m, rho, h, wstart, wseg, seg, elevation, held, tdx,
+                                  tdy)
         ghost[i] = d_ghost
         if d_ghost > 0.0:
             e = math.sqrt(ex * ex + ey * ey)
@@ -309,6 +352,9 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         ixx, ixy, iyy = _inverse(nxx, nxy, nyy)
         ax[i] = acc[0] - GRAVITY * (ixx * sx + ixy * sy)
         ay[i] = acc[1] - GRAVITY * (ixy * sx + iyy * sy)
+        if bank_held[i] == HELD:
+            ax[i] -= u[i] / HOLD_TIME
+            ay[i] -= v[i] / HOLD_TIME
         beta = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
         divv[i] = -beta * acc[9] / rho[i]
 

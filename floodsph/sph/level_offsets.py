@@ -14,6 +14,21 @@ wet DEM cells (``floodsph.inputs.initial_water.seed_particles``), and b the solv
 the particle. The offset belongs to the water at rest; once it moves it fades over the
 distance travelled, o_i <- o_i exp(-|v_i| dt / h_i) (:func:`decay_offsets`), so that moving
 water is pushed by its own depth's differences.
+
+Still water held by its banks. A particle is a marker in the water: in a lake at rest the
+level it reports must not change when it drifts a little, but the summation depth of a particle
+between deep and shallow neighbours changes with where it stands among them, and a fading
+offset turns speed into a change of level. Either drove a disturbed lake unstable next to its
+banks. So while a particle is still water that its banks hold (``bank_held`` = ``HELD``, set at
+set-up, ``floodsph.sph.level_momentum``):
+
+* its depth follows continuity alone, d <- d (1 - dt div v) (the density solve leaves it),
+  so that it rises under compression and falls under expansion;
+* its offset does not fade.
+
+When it is released (``RELEASED``), the density solve takes it again, and its offset takes
+the difference between its continuity depth and its summation depth, so that its level does
+not jump (:func:`release`); from then on the offset fades as for any moving water.
 """
 
 from __future__ import annotations
@@ -25,6 +40,14 @@ from numba import njit, prange
 
 from floodsph.constants import RHO_WATER
 from floodsph.sph.bed import elevation_at
+
+FREE = 0
+"""``bank_held`` of water that is not held by its banks (moving, or with a free edge)."""
+HELD = 1
+"""``bank_held`` of still water held by its banks (module docstring)."""
+RELEASED = -1
+"""``bank_held`` of water that left ``HELD`` in the last force evaluation, whose offset the
+next density solve matches (:func:`release`)."""
 
 
 @njit(parallel=True, cache=True)
@@ -38,12 +61,23 @@ def levels(x, y, rho, offset, elevation, tdx, tdy, eta):
 
 
 @njit(parallel=True, cache=True)
-def decay_offsets(u, v, h, dt, offset):
+def decay_offsets(u, v, h, dt, bank_held, offset):
     """o_i <- o_i exp(-|v_i| dt / h_i): the offset fades over the distance travelled, in units of
-    the smoothing length (module docstring)."""
+    the smoothing length, except for the ``HELD`` particles of ``bank_held`` (module
+    docstring)."""
     for i in prange(offset.shape[0]):
-        if offset[i] != 0.0:
+        if offset[i] != 0.0 and bank_held[i] != HELD:
             offset[i] *= math.exp(-math.sqrt(u[i] * u[i] + v[i] * v[i]) * dt / h[i])
+
+
+def release(bank_held: np.ndarray, rho_continuity: np.ndarray, rho: np.ndarray,
+            offset: np.ndarray) -> None:
+    """o <- o + (rho_continuity - rho) / rho_w [m] for the ``RELEASED`` particles, whose depth
+    the density solve took from continuity (``rho_continuity``) to summation (``rho``) [kg
+    m-2]; they become ``FREE`` (module docstring)."""
+    released = bank_held == RELEASED
+    offset[released] += (rho_continuity[released] - rho[released]) / RHO_WATER
+    bank_held[released] = FREE
 
 
 def match_offsets(eta_seed: np.ndarray, rho: np.ndarray, bed: np.ndarray,

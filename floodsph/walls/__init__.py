@@ -16,7 +16,7 @@ the edges are closed. Three mechanisms keep water on its side:
    bends, a point hidden behind one segment may be the image of a particle in front of the
    next (an earlier version required the foot on the segment, and lost those images near every
    vertex of a polyline). A sight line exactly through a vertex is settled by a fixed shift of
-   1e-7 m (:func:`hides`), so that point is imaged once. In a right-angled corner where two
+   1 mm (:func:`hides`), so that point is imaged once. In a right-angled corner where two
    near segments meet, j's foot on both gives a third image, the reflection of j's first image
    about the second wall (the point reflection through the corner), which completes the kernel
    there too.

@@ -16,8 +16,13 @@ from numba import njit, prange
 
 from floodsph.walls.geometry import crosses, mirror, segment_distance
 
-TIE_SHIFT = (0.6e-7, 0.8e-7)
-"""Offset [m] of the sight lines of :func:`hides` (a fixed direction, 1e-7 m long)."""
+TIE_SHIFT = (0.6e-3, 0.8e-3)
+"""Offset [m] of the sight lines of :func:`hides` (a fixed direction, 1 mm long). Particles
+seeded on DEM cell centres see each other along lines through the cell corners, where a
+walled nodata border has its vertices: the shift must exceed what a lake at rest moves under
+a slight disturbance, or pairs flip between seen and hidden and the depth jumps by metres
+(a Malpasset reservoir disturbed by 1e-6 m/s moved 5e-8 m in a step, across a 1e-7 m shift),
+and stay far below a particle's size and the walls' own accuracy."""
 
 
 @njit(inline="always", cache=True)
@@ -35,9 +40,9 @@ def hides(ax, ay, bx, by, seg, s):
                    seg[s, 3])
 
 
-SIGHT_SLACK = 1e-6
+SIGHT_SLACK = 1e-2
 """Slack [m] of the distance tests that skip far segments: a segment that :func:`hides` a
-point at distance r from particle i lies within r + |TIE_SHIFT| (1e-7 m) of i, so one
+point at distance r from particle i lies within r + |TIE_SHIFT| (1 mm) of i, so one
 farther than r + SIGHT_SLACK neither blocks the pair nor makes an image within r (the margin
 also covers rounding, ~1e-10 m at 1e5 m from the origin)."""
 
