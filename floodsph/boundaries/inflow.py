@@ -67,7 +67,7 @@ class Inflow:
     line : (2, 2) array
         End points A, B of the section in local coordinates [m].
     hydrograph : Hydrograph
-        ``discharge(t)`` [m3/s] and ``volume(t0, t1)`` [m3] (``floodsph.inputs.hydrograph``).
+        ``discharge(t)`` [m3/s] and ``volume(t0, t1)`` [m3] (``floodsph.io.hydrograph``).
     spacing, kappa : float
         Particle spacing dx [m] and h / dx of the injected particles.
     terrain : Terrain

@@ -23,7 +23,7 @@ import numpy as np
 
 from floodsph.breach import formulas
 from floodsph.breach.params import BreachParams, BreachSetup, resolve
-from floodsph.inputs.hydrograph import Hydrograph
+from floodsph.io.hydrograph import Hydrograph
 
 #: Without duration_s, the routing stops once the breach has formed and the outflow has fallen
 #: below this fraction of the peak (and the reservoir inflow has ended) ...

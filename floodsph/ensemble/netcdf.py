@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from floodsph.ensemble.aggregate import UK_CLASSES, EnsembleMaps
-from floodsph.run.atomic_files import atomic_path
+from floodsph.io.atomic_files import atomic_path
 
 #: variable -> (dimension, long name, units)
 VARIABLES = {

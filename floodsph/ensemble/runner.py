@@ -215,7 +215,7 @@ def check_extreme_members(spec: EnsembleSpec, plan: EnsemblePlan) -> list[str]:
 def _record_interrupted(to_run, results: dict, reason: str) -> None:
     """Members that were running when the ensemble was interrupted: ``interrupted`` in
     ``results`` and in their own ``run.json`` (left at ``running`` by the closed worker)."""
-    from floodsph.run.folder import STAGING_DIR
+    from floodsph.io.run_names import STAGING_DIR
     from floodsph.run.manifest import read_manifest, write_manifest
 
     for member in to_run:

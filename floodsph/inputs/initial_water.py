@@ -44,7 +44,7 @@ def wet_cells(terrain: Terrain, walled: bool) -> np.ndarray:
     """The cells initial water may fill: the valid ones, and where the nodata border is walled
     (closed edges) the nodata slivers inside its simplified walls
     (:func:`floodsph.walls.nodata.walled_slivers`), which the water reaches in the
-    model as well; their bed is the nearest valid elevation (``floodsph.io.dem``)."""
+    model as well; their bed is the nearest valid elevation (``floodsph.inputs.dem``)."""
     if not walled:
         return terrain.valid
     return terrain.valid | walled_slivers(terrain.valid, terrain.dx, terrain.dy)
@@ -86,7 +86,7 @@ def depth_from_level(
 def stray_slivers(inside: np.ndarray, valid: np.ndarray) -> np.ndarray:
     """The nodata cells of ``inside`` whose nearest valid cell is not inside: (ny, nx) bool.
 
-    A nodata sliver takes the bed of its nearest valid cell (``floodsph.io.dem``) and belongs
+    A nodata sliver takes the bed of its nearest valid cell (``floodsph.inputs.dem``) and belongs
     to that cell's side of the walls (:func:`floodsph.walls.nodata.walled_slivers`). A polygon
     may hold the sliver but not that cell: on Malpasset's 20 m DEM the slivers of a side
     valley beyond the dam, 1-2 cells from the reservoir across the nodata, took the valley's bed

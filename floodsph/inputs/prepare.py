@@ -6,7 +6,7 @@ created (``floodsph check`` stops after it and prints :func:`summary_lines`):
 1. read or route the inflow hydrographs and integrate them up to the end time;
 2. read the DEM's header and refuse a run too large for the memory available, from the grid
    shapes alone (``floodsph.inputs.memory``), before any grid is allocated;
-3. load the DEM and roughness (``floodsph.io.dem.load_terrain``: fill values, feet, Manning
+3. load the DEM and roughness (``floodsph.inputs.dem.load_terrain``: fill values, feet, Manning
    values that are Strickler coefficients);
 4. read the geometry given as vector files, reprojected into the DEM's CRS
    (``floodsph.inputs.vectors``), and check that all of it lies on the DEM
@@ -38,7 +38,6 @@ from floodsph.checks.inflows import check_inflows
 from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
-from floodsph.inputs.coordinates import inline_to_model
 from floodsph.inputs.memory import (
     MemoryEstimate,
     check_memory,
@@ -48,6 +47,7 @@ from floodsph.inputs.memory import (
 )
 from floodsph.inputs.run_time import estimate_run_time, run_threads, warn_if_huge
 from floodsph.inputs.vectors import vector_gauges, with_vector_geometry
+from floodsph.io.coordinates import inline_to_model
 from floodsph.io.raster import crs_label
 from floodsph.io.vector import is_vector_file
 from floodsph.scenario.config import Scenario
@@ -59,7 +59,7 @@ class Inputs:
 
     ``walls`` (polylines) and ``sinks`` (polygons) are (k, 2) arrays, inline ones and those
     read from vector files alike. ``inflows`` are the scenario's ``[[inflows]]`` with their
-    line and direction in the terrain's CRS (``floodsph.inputs.coordinates``). ``warnings``
+    line and direction in the terrain's CRS (``floodsph.io.coordinates``). ``warnings``
     lists the inputs accepted with a warning (each also logged at WARNING); ``conversions``
     the units the input files were converted from (hydrographs in hours or cubic feet per
     second, dates), one sentence per file.
@@ -85,8 +85,8 @@ class Inputs:
 def prepare_inputs(scenario: Scenario) -> Inputs:
     """Load and check everything a run needs; raises ``InputError`` on bad input, including a
     run whose memory estimate exceeds the memory available (before allocating it)."""
+    from floodsph.inputs.dem import load_terrain
     from floodsph.inputs.initial_water import seed_particles, wet_cells
-    from floodsph.io.dem import load_terrain
 
     tc = scenario.terrain
     source = str(scenario.path.name)
@@ -216,7 +216,7 @@ def estimate_before_reading(scenario: Scenario, volume_inflow_m3: float,
     the DEM's grids, the rasters read (``read_cells``, default :func:`cells_read`), the map
     grids, the seeding lattice and the inflow particles (no initial particles yet: they need
     the depth grid)."""
-    from floodsph.io.dem import check_dem_size, planned_grid
+    from floodsph.inputs.dem import check_dem_size, planned_grid
     from floodsph.io.mosaic import read_dem_header, tile_names
 
     tc = scenario.terrain
@@ -257,10 +257,10 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
 
 
 def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None) -> list:
-    """One :class:`~floodsph.inputs.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
+    """One :class:`~floodsph.io.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
     one place it is read; dates count from ``scenario.start``), or its breach (validated by
     ``floodsph.scenario.config``) routed. ``conversions`` receives the units converted."""
-    from floodsph.inputs.hydrograph import Hydrograph, read_hydrograph
+    from floodsph.io.hydrograph import Hydrograph, read_hydrograph
 
     source = str(scenario.path.name)
     out = []
@@ -279,7 +279,7 @@ def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None)
 def crs_lines(terrain) -> list[str]:
     """The ``check`` lines on the CRSs: the model's and the maps' (with its scale factors over
     the domain), the DEM file's when it differs, and the one of the inline coordinates."""
-    from floodsph.inputs.coordinates import coordinates_label
+    from floodsph.io.coordinates import coordinates_label
     from floodsph.io.crs import scale_range
 
     if not terrain.crs_wkt:

@@ -2,7 +2,7 @@
 
 Every reader here turns rasterio/GDAL failures into one :class:`~floodsph.errors.InputError`
 that names the file, and every grid is handled *north-up* (row 0 = north, as rasterio
-returns it). Only :func:`floodsph.io.dem.load_terrain` flips to the solver's south-up order.
+returns it). Only :func:`floodsph.inputs.dem.load_terrain` flips to the solver's south-up order.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ step. In order:
 1. the closed sides are checked, and the open ones get transmissive ghosts
    (``floodsph.boundaries.OpenEdges``) ahead of the other boundaries;
 2. the wall segments are laid out: the scenario's walls, the closed DEM border and the
-   nodata banks, with the boundaries' openings cut out (``floodsph.walls.layout``);
+   nodata banks, with the boundaries' openings cut out (``floodsph.model.wall_layout``);
 3. the boundaries act once at t = 0 (an inflow fills its buffer);
 4. seeds are moved off nodata and wall lines (``floodsph.walls.nodata.settle_seeds``), and
    those off the grid (or on open nodata) removed as outflow;
@@ -27,9 +27,9 @@ from floodsph.constants import RHO_WATER
 from floodsph.model.flood_model import FloodModel
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
+from floodsph.model.wall_layout import model_segments
 from floodsph.model.wall_seeds import settle_at_walls
 from floodsph.scenario.numerics import Numerics
-from floodsph.walls.layout import model_segments
 from floodsph.walls.nodata import settle_seeds
 
 

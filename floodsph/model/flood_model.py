@@ -35,6 +35,7 @@ from floodsph.sph import (
     forces,
     level_momentum,
     level_offsets,
+    shadow,
     shore,
     time_step,
 )
@@ -42,7 +43,7 @@ from floodsph.sph.cells import CellGrid
 from floodsph.sph.neighbours import NeighbourList
 from floodsph.sph.sums import SUMS
 from floodsph.sph.velocity_gradient import velocity_gradient
-from floodsph.walls import shadow, sight
+from floodsph.walls import sight
 from floodsph.walls.index import WallIndex, WallLists
 
 MAX_SEARCH_GROWTH = 2.0
@@ -68,7 +69,7 @@ class FloodModel:
         given.
     seg : (k, 4) array
         Wall segments (x0, y0, x1, y1) [m] that water cannot cross
-        (``floodsph.walls.layout.model_segments``).
+        (``floodsph.model.wall_layout.model_segments``).
     closed_edges : bool or tuple of str
         As given to the builder: True, False, or the closed sides.
     boundaries : sequence of floodsph.boundaries.protocol.Boundary
@@ -360,7 +361,7 @@ class FloodModel:
     def wall_lists(self) -> WallLists:
         """The walls as the density and force kernels take them: with ``wall_model =
         "integral"`` no segment makes images (its distance infinite, no corners), and the
-        walls act through ``floodsph.walls.shadow``."""
+        walls act through ``floodsph.sph.shadow``."""
         wstart, wseg, cstart, cpair = self.walls_near
         if not self.integral_walls:
             return WallLists(self.seg, self.wdist, wstart, wseg, cstart, cpair)

@@ -15,7 +15,7 @@
 
 Particles sample these grids bilinearly (``floodsph.sph.bed``). Analytic test beds are built
 through the same type with :meth:`Terrain.from_function`, so tests exercise the real path.
-DEM files are read by ``floodsph.io.dem``, which returns a ``Terrain``.
+DEM files are read by ``floodsph.inputs.dem``, which returns a ``Terrain``.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ class Terrain:
         (``floodsph.io.crs``); None for a geographic DEM or a synthetic bed.
     coordinates_crs_wkt : str or None
         The CRS of the scenario's inline coordinates when ``[scenario] crs`` names one; None:
-        ``source_crs_wkt`` (``floodsph.inputs.coordinates``).
+        ``source_crs_wkt`` (``floodsph.io.coordinates``).
     """
 
     elevation: np.ndarray

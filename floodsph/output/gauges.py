@@ -19,7 +19,7 @@ import numpy as np
 
 from floodsph.checks.placement import lonlat_hint, user_extent_text
 from floodsph.errors import InputError
-from floodsph.inputs.coordinates import to_model
+from floodsph.io.coordinates import to_model
 from floodsph.io.text import header_found, read_text
 from floodsph.output.grid import bilinear
 
@@ -40,7 +40,7 @@ class GaugePoints:
 
 def read_gauge_file(path, terrain) -> GaugePoints:
     """Read a UTF-8 CSV (a BOM allowed) with columns ``id, x, y`` (world coordinates in the
-    CRS of the inline coordinates, ``floodsph.inputs.coordinates``).
+    CRS of the inline coordinates, ``floodsph.io.coordinates``).
 
     Raises InputError naming the file and line for a file that is not UTF-8, a missing
     column, a non-numeric coordinate, a duplicate id or a point outside the DEM (saying so

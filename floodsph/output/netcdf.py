@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.io.atomic_files import atomic_path
 from floodsph.output.cf import (
     CLASS_DTYPE,
     COORD_ATTRS,
@@ -35,7 +36,6 @@ from floodsph.output.cf import (
     time_attrs,
     variable_attrs,
 )
-from floodsph.run.atomic_files import atomic_path
 
 
 def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,

@@ -12,7 +12,7 @@ scenario), ``status`` (``"running"`` while the run is under way, then ``"complet
 mean, run anyway), ``checkpoint_time_s`` (the latest checkpoint) and ``resumed_from`` (the
 checkpoint times the run was resumed from).
 
-The file is written atomically (``floodsph.run.atomic_files``), so a reader never sees half a
+The file is written atomically (``floodsph.io.atomic_files``), so a reader never sees half a
 manifest.
 """
 
@@ -25,7 +25,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from floodsph._version import __version__
-from floodsph.run.atomic_files import atomic_path
+from floodsph.io.atomic_files import atomic_path
 
 MANIFEST_NAME = "run.json"
 

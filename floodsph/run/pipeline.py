@@ -27,9 +27,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from floodsph.errors import InputError
-from floodsph.run.atomic_files import TEMP_PREFIX, atomic_path
-from floodsph.run.atomic_files import umask as _umask
-from floodsph.run.folder import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME, RunFolder
+from floodsph.io.atomic_files import TEMP_PREFIX, atomic_path
+from floodsph.io.atomic_files import umask as _umask
+from floodsph.io.run_names import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME
+from floodsph.run.folder import RunFolder
 from floodsph.run.log_file import attach_log, detach_log
 from floodsph.run.manifest import new_manifest, now_iso, write_manifest
 from floodsph.scenario.config import Scenario
@@ -114,7 +115,7 @@ class RunOptions:
 
 def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
     """The run proper, in the opened folder ``work``; see :func:`run_scenario`."""
-    from floodsph.inputs.coordinates import coordinates_wkt
+    from floodsph.io.coordinates import coordinates_wkt
     from floodsph.io.raster import crs_label
 
     log_handler = attach_log(work / LOG_NAME, append=checkpoint is not None)
@@ -270,7 +271,7 @@ def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]
     The file ``breach_hydrograph_<i>.csv`` (time_s, discharge_m3s) in the run folder is what
     the run used, so it can be checked or reused as a ``hydrograph`` input.
     """
-    from floodsph.inputs.hydrograph import write_hydrograph_csv
+    from floodsph.io.hydrograph import write_hydrograph_csv
 
     names = []
     for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,

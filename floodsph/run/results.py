@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from floodsph.errors import InputError
-from floodsph.run.folder import MAP_NAMES
+from floodsph.io.run_names import MAP_NAMES
 from floodsph.run.manifest import MANIFEST_NAME, read_manifest
 
 NETCDF_MAPS = "flood_maps.nc"

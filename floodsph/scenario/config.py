@@ -17,7 +17,7 @@ from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from floodsph.checks.roughness import N_DEFAULT
+from floodsph.io.roughness import N_DEFAULT
 from floodsph.scenario.numerics import Numerics
 
 if TYPE_CHECKING:
@@ -46,7 +46,7 @@ class ScenarioInfo:
     the calendar instant of its start (time zone aware, None when the scenario gives none;
     hydrograph dates count from it). ``crs`` is the CRS of the inline coordinates (polygons,
     lines, extents) when they are not in the DEM file's own CRS
-    (``floodsph.inputs.coordinates``)."""
+    (``floodsph.io.coordinates``)."""
 
     name: str
     end_time_s: float

@@ -60,7 +60,7 @@ class Momentum(Enum):
 
 class WallModel(Enum):
     """How walls hold water: mirror images (``floodsph.walls.images``), or the experimental
-    boundary integral (``floodsph.walls.shadow``; measured in ``docs/still-water.md``)."""
+    boundary integral (``floodsph.sph.shadow``; measured in ``docs/still-water.md``)."""
 
     MIRROR = "mirror"
     INTEGRAL = "integral"
@@ -121,7 +121,7 @@ class Numerics:
         particles.
     step_levels : K of local stepping: a big step holds up to 2^K finest steps.
     wall_model : "mirror" (mirror images, the default) or "integral" (the experimental
-        boundary integral of ``floodsph.walls.shadow``).
+        boundary integral of ``floodsph.sph.shadow``).
     momentum : "variational" (the default) or "balanced": -g grad eta as renormalised
         differences of the free-surface level eta, a lake at rest an exact equilibrium
         (``floodsph.sph.level_momentum``); with the "lax-friedrichs" stabilisation and

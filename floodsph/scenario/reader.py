@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from floodsph.checks.elevation import ELEVATION_LIMIT_M
-from floodsph.checks.roughness import N_STRICKLER, strickler_text
+from floodsph.io.roughness import N_STRICKLER, strickler_text
 from floodsph.scenario.config import (
     SIDES,
     TOP_KEYS,

@@ -19,16 +19,11 @@ from pathlib import Path
 from typing import Any
 
 from floodsph.checks.shapes import polygon_problem, polyline_problem
+from floodsph.constants import LARGEST_VALUE
 from floodsph.errors import InputError
 
 #: Marks a key without a default: absent means "missing required key".
 REQUIRED = object()
-
-LARGEST_VALUE = 1.0e12
-"""The largest magnitude any number of a scenario may have. No quantity of a flood scenario in
-SI units comes near it (projected coordinates stay below 1e8 m, the largest reservoirs hold
-2e11 m3, 1e12 s is 30,000 years), while a value beyond it (1e308) overflows to infinity in
-the first product it enters."""
 
 
 def read_toml(path: Path, what: str) -> dict:

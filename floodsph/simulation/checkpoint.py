@@ -30,8 +30,8 @@ from pathlib import Path
 
 from floodsph._version import __version__
 from floodsph.errors import InputError
-from floodsph.run.atomic_files import atomic_path
-from floodsph.run.folder import CHECKPOINT_DIR
+from floodsph.io.atomic_files import atomic_path
+from floodsph.io.run_names import CHECKPOINT_DIR
 
 STATE_NAME = "state.pkl"
 FORMAT = 3

@@ -37,8 +37,8 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import w_cubic, w_dwdr_cubic
+from floodsph.sph.shadow import shadow
 from floodsph.walls.images import corner_image, wall_image
-from floodsph.walls.shadow import shadow
 from floodsph.walls.sight import SIGHT_SLACK
 
 H_SHRINK_MIN = 0.8
@@ -143,7 +143,7 @@ def summation(i, hi, x, y, m, nstart, nbr, blocked, walls):
 
 
 GAMMA_MIN = 0.25
-"""Least water fraction gamma = 1 - S of a support (``floodsph.walls.shadow``) that the
+"""Least water fraction gamma = 1 - S of a support (``floodsph.sph.shadow``) that the
 depth is corrected by: a particle pressed into a corner (gamma 0.25 at the vertex of a right
 angle) is not made deeper still."""
 
@@ -151,7 +151,7 @@ angle) is not made deeper still."""
 @njit(inline="always", cache=True)
 def wall_corrected(i, hi, rsum, alpha, x, y, wstart, wseg, seg):
     """The summation (1) and alpha_i of particle i divided by the water fraction of its support,
-    gamma_i = 1 - S_i(h_i) (``floodsph.walls.shadow.shadow``, at least ``GAMMA_MIN``):
+    gamma_i = 1 - S_i(h_i) (``floodsph.sph.shadow.shadow``, at least ``GAMMA_MIN``):
     rho_i = sum_j m_j W(r_ij, h_i) / gamma_i, the depth of water that fills the support up to the
     walls (Ferrand et al., IJNMF 71 (2013) 446-472, eq. 13). alpha_i is divided alike; the
     derivative of gamma in h is left out of it (the Newton update (3) then converges linearly

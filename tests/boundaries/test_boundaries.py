@@ -20,7 +20,7 @@ from floodsph.boundaries.inflow import lattice_alpha_ratio
 from floodsph.boundaries.riemann import critical_depth, inflow_state
 from floodsph.constants import GRAVITY
 from floodsph.errors import InputError
-from floodsph.inputs.hydrograph import Hydrograph
+from floodsph.io.hydrograph import Hydrograph
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics

@@ -30,10 +30,10 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.constants import LARGEST_VALUE
 from floodsph.errors import InputError
+from floodsph.io.atomic_files import atomic_path
 from floodsph.io.text import read_csv_rows
-from floodsph.run.atomic_files import atomic_path
-from floodsph.scenario.schema import LARGEST_VALUE
 
 TIME_COLUMN = "time_s"
 DISCHARGE_COLUMN = "discharge_m3s"

@@ -3,7 +3,7 @@
 The scenario's inline coordinates (``initial_water.polygon``, ``walls.polyline``,
 ``inflows.line`` and ``direction``, ``sinks.polygon``, ``terrain.extent``, the x and y of a
 gauges CSV) are in the DEM file's own CRS, or in ``[scenario] crs`` when that is given. The
-model runs in ground metres (``floodsph.io.dem``): the DEM file's CRS itself, or the UTM zone
+model runs in ground metres (``floodsph.inputs.dem``): the DEM file's CRS itself, or the UTM zone
 a geographic or distorting DEM was reprojected to, or the metre version of a CRS in feet. The
 inline coordinates are transformed into that CRS here (pyproj, longitude/easting first), once,
 before any check; vector files are reprojected from their own CRS by ``floodsph.io.vector``.

@@ -37,7 +37,6 @@ from rasterio.warp import calculate_default_transform, reproject, transform_boun
 from scipy import ndimage
 
 from floodsph.checks.elevation import check_elevations, vertical_unit
-from floodsph.checks.roughness import N_DEFAULT
 from floodsph.errors import InputError, warn
 from floodsph.io.crs import (
     SCALE_TOLERANCE,
@@ -50,6 +49,7 @@ from floodsph.io.crs import (
 from floodsph.io.manning import manning_grid
 from floodsph.io.mosaic import read_dem_grid, tile_names
 from floodsph.io.raster import Grid, GridHeader, crs_label, parse_crs
+from floodsph.io.roughness import N_DEFAULT
 from floodsph.model.terrain import Terrain
 
 log = logging.getLogger(__name__)
