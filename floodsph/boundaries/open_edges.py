@@ -1,11 +1,11 @@
 """Open DEM edges: an outflow buffer of departed particles with the interior state imposed.
 
-Method (sph-swe-method.md section 3.2, outlets): fluid particles that cross an open side of the
+Method (``docs/method.md`` §8, open edges): fluid particles that cross an open side of the
 DEM rectangle leave the model - their volume is counted as outflow - and become buffer
 particles that keep moving outwards until they are farther than the kernel reach 2 h (1 + skin)
 beyond the edge. Every step the buffer takes part in the neighbour search as ghosts, and after
 the density solve each buffer particle is given the interior state, a Shepard average over its
-fluid neighbours (the "inner" state d_I, v_I of section 3.2):
+fluid neighbours (the "inner" state d_I, v_I):
 
     d_I = sum_j V_j d_j W(r_ij, h_i) / sum_j V_j W(r_ij, h_i),  V_j = m_j / rho_j,
 

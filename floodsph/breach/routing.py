@@ -1,7 +1,7 @@
 """Level-pool routing of a reservoir through a growing trapezoidal breach.
 
 The reservoir storage V obeys dV/dt = Q_in(t) - Q_b(H(V), t) (HEC-RAS level-pool practice,
-flood-practice.md §1.2), with H(V) the storage-elevation curve and Q_b the free broad-crested
+``docs/breach.md`` §2), with H(V) the storage-elevation curve and Q_b the free broad-crested
 weir flow through the breach (:func:`floodsph.breach.formulas.trapezoid_weir_discharge`).
 From initiation at ``start_time_s`` the breach grows over the formation time t_f by the fraction
 r(tau) (linear or sine progression): bottom width b = r B, bottom elevation

@@ -191,7 +191,7 @@ def lump_thin_cells(d: np.ndarray, ratio: float = LUMP_RATIO) -> np.ndarray:
     sqrt(ratio) or more times smaller than theirs. Such particles set the time step of the
     whole run (a reservoir's shore seeds of a few cm, whose h falls to the h0 / h_ratio bound
     when the flood carries them into metres of water), and neighbour h ratios above about 2-3
-    degrade accuracy (method notes, section 7). Where the water is that thin the shore moves
+    degrade accuracy (``docs/method.md`` §1). Where the water is that thin the shore moves
     inwards, by one spacing, or more where a cell that received water is in turn lumped.
     """
     d = d.copy()

@@ -1,6 +1,7 @@
 """Manning's n on the DEM grid: a constant, an n raster, or land cover + a class table.
 
-Forms (flood-practice.md §1.1, as in AutoRoutePy and HydroMT mapping tables):
+Forms (``docs/scenario-reference.md``, ``[terrain]``; as in AutoRoutePy and HydroMT mapping
+tables):
 
 * a number: uniform n [s m^-1/3];
 * a raster of n on any grid / CRS: reprojected onto the DEM grid, bilinear resampling;

@@ -2,12 +2,11 @@
 
 Free global DEMs (SRTM, Copernicus GLO-30, ALOS, FABDEM) come in 1-degree tiles, and a study
 area often crosses a tile edge. Each tile is read as any raster
-(:func:`floodsph.io.raster.read_grid`: its own nodata value becomes NaN, so tiles may differ
-in it); a tile in another CRS than the
-first is reprojected (bilinear) to the first one's at the first one's cell size, with a
-warning; then ``rasterio.merge.merge`` lays them on the first tile's grid over the union of
-their bounds, the first tile that has data winning where tiles overlap. Cells no tile covers
-are nodata.
+(:func:`floodsph.io.raster.read_grid`: its own nodata value becomes NaN, so tiles may differ in
+it); a tile in another CRS than the first is reprojected (bilinear) to the first one's at the
+first one's cell size, with a warning; then ``rasterio.merge.merge`` lays them on the first
+tile's grid over the union of their bounds, the first tile that has data winning where tiles
+overlap. Cells no tile covers are nodata.
 
 A GDAL VRT mosaic (``gdalbuildvrt dem.vrt tiles/*.tif``) is read as one file and works too.
 """

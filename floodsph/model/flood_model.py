@@ -2,7 +2,7 @@
 
 The model knows how to take a step and nothing about files, schedules or output (those are
 ``floodsph.simulation.loop``'s). One step (kick-drift-kick leap-frog with a variable CFL step,
-method notes 2.6-2.7):
+``docs/method.md`` §5):
 
 1. kick   v^{n+1/2} = v^n + a^n dt / 2
 2. drift  x^{n+1} = x^n + v^{n+1/2} dt; moves across walls are reflected; particles that

@@ -9,7 +9,8 @@ class maps) and evaluates only the cells the reference map covers. A cell is wet
 depth is above the threshold (class maps: class > 0; the other quantities: where the map
 has a value); NaN/nodata counts as dry.
 With hits = wet in both, false alarms = wet in the model only, misses = wet in the reference
-only (flood-practice.md section 1.6; seamlesswave.com/metrics; Wing et al. 2017 use 0.10 m):
+only (``docs/outputs.md``, ``floodsph compare`` outputs; seamlesswave.com/metrics; Wing et al.
+2017 use 0.10 m):
 
     H   = hits / (hits + misses)                               hit rate
     FAR = false alarms / (hits + false alarms)                 false alarm ratio

@@ -44,7 +44,7 @@ from floodsph.io.run_names import (
 )
 from floodsph.run.manifest import MANIFEST_NAME, read_manifest
 
-#: Every file name a run writes (scenario-format.md, "Run folder"); a run's files in progress
+#: Every file name a run writes (``docs/run-folder.md``); a run's files in progress
 #: carry one of these names with a suffix (``snapshots.nc.part``, ``max_depth.tif.part``).
 RUN_FILES = (*MAP_NAMES, SNAPSHOTS_NAME, GAUGES_NAME, MASS_BALANCE_NAME, MANIFEST_NAME,
              RESOLVED_NAME, LOG_NAME, *PICTURE_NAMES, *SERIES_PICTURE_NAMES, REPORT_NAME)

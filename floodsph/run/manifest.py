@@ -1,9 +1,9 @@
 """The run manifest ``run.json``: what ran, how it ended, and its key numbers.
 
-Keys (contract, ``scenario-format.md``): ``floodsph_version``, ``scenario`` (the resolved
-scenario), ``status`` (``"running"`` while the run is under way, then ``"completed"``,
-``"stopped"`` (``--max-steps`` reached first), ``"interrupted"`` or ``"failed"``),
-``sim_time_s``, ``wall_time_s``, ``steps``,
+Keys (the contract, ``docs/run-folder.md`` and ``docs/outputs.md``): ``floodsph_version``,
+``scenario`` (the resolved scenario), ``status`` (``"running"`` while the run is under way,
+then ``"completed"``, ``"stopped"`` (``--max-steps`` reached first), ``"interrupted"`` or
+``"failed"``), ``sim_time_s``, ``wall_time_s``, ``steps``,
 ``particles_initial``, ``particles_max``, ``particles_final``, ``splits``, ``merges``,
 ``mass_error_rel``, ``threads``; and in addition ``error`` (the message of a failed run),
 ``numba_version``, ``python_version``, ``started``/``finished`` (ISO 8601, UTC),

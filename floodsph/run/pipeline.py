@@ -1,6 +1,6 @@
 """``run_scenario``: one scenario from its TOML to a finished run folder.
 
-The chain (architecture.md 3.2): every test ``floodsph check`` makes, in the one function
+The chain (``docs/developing.md``): every test ``floodsph check`` makes, in the one function
 both call (``floodsph.run.preflight``: the run folder, with nothing that is not a floodsph
 run's and no completed run unless replaced; the inputs -- terrain, particles, hydrographs,
 inflow sides, memory -- all before the run folder is touched) -> the folder is locked and
@@ -12,8 +12,8 @@ mass-balance, progress, recorder and checkpoint callbacks -> maps, gauges and ma
 
 ``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached
 before the end time); ``"interrupted"`` (SIGINT, SIGTERM or SIGHUP:
-``floodsph.simulation.stop_signals``;
-once the time loop runs, a checkpoint is written first and the manifest is returned);
+``floodsph.simulation.stop_signals``; once the time loop runs, a checkpoint is written first
+and the manifest is returned);
 ``"failed"`` (the exception is re-raised, its one-line message is in ``error``). A run that
 replaces a completed one is built in ``.floodsph-new/`` and swapped in when it completes.
 """

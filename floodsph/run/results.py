@@ -1,7 +1,7 @@
 """A finished run folder as Python objects: its manifest and its maps as an xarray Dataset.
 
 :class:`RunResult` is what :func:`floodsph.run_scenario` returns and :func:`open_run` reads
-back from any run folder (scenario-format.md, "Run folder"). Its maps come from
+back from any run folder (``docs/run-folder.md``). Its maps come from
 ``flood_maps.nc`` when the run wrote it, else from the GeoTIFFs; either way it is the same
 Dataset, that of ``flood_maps.nc`` (class maps as uint8): one variable per map
 (``max_depth`` [m], ``max_speed`` [m/s], ..., ``hazard_uk``), cell-centre coordinates ``x``

@@ -122,8 +122,7 @@ class Inflow:
     """``[[inflows]]``: a breach section with a discharge hydrograph Q(t) [m3/s].
 
     ``hydrograph`` is the CSV of Q(t) (read by ``floodsph.inputs.prepare``, as every file the
-    scenario
-    names); ``breach`` the validated ``[inflows.breach]`` table of a parametric breach
+    scenario names); ``breach`` the validated ``[inflows.breach]`` table of a parametric breach
     (``floodsph.breach.params.BreachParams``, file paths absolute), routed into Q(t) there.
 
     ``direction`` (optional) is the flow direction [dx, dy]; by default water enters normal

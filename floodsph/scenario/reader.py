@@ -324,8 +324,7 @@ def _gauges(r: Reader, data: dict) -> Gauges | None:
 
 def _numerics(r: Reader, data: dict) -> Numerics:
     """``[numerics]`` straight into :class:`~floodsph.scenario.numerics.Numerics`: each key read as
-    the
-    type of its field, then checked by ``Numerics`` itself (bounds, the refinement rule)."""
+    the type of its field, then checked by ``Numerics`` itself (bounds, the refinement rule)."""
     p = "numerics"
     t = r.sub_table(data, "", p, NUMERICS_KEYS)
     values = {}

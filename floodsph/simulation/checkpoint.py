@@ -1,6 +1,6 @@
 """Checkpoints: the whole state of a run, saved so that it can continue as if never stopped.
 
-A checkpoint (scenario-format.md, "Checkpoints and resuming a run") holds:
+A checkpoint (``docs/run-folder.md``, "Checkpoints and ``--resume``") holds:
 
 * the model: particles, neighbour and wall lists, boundary and inflow state, refinement
   state, the clock and the counters (the terrain is not stored: it is read again from the

@@ -1,7 +1,7 @@
 """Depth from SPH density: the Newton-Raphson solve of density and smoothing length.
 
 Equations (Vacondio et al., Adv. Water Resour. 58 (2013) 10-23; Rodriguez-Paz & Bonet,
-Comput. Struct. 83 (2005) 1396-1410; method notes sections 1.4-1.5):
+Comput. Struct. 83 (2005) 1396-1410; ``docs/method.md`` §2):
 
     rho_i = sum_j m_j W(r_ij, h_i)                     (1)  gather summation, self included
     h_i   = h0_i (rho0_i / rho_i)^(1/2)                (2)  d_m = 2
@@ -59,7 +59,7 @@ def _pair(rx, ry, mj, hi):
 def _image(i, j, x, y, m, hi, seg, s):
     """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's mirror image across segment s
     (x_j' = 2 f_j - x_j, ``floodsph.walls.images.wall_image``) seen from i; (0, 0) when the wall
-    does not hide that image's point from i (MVBP mirror particles, method notes 3.1)."""
+    does not hide that image's point from i (MVBP mirror particles, ``docs/method.md`` §7)."""
     xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
     if not ok:
         return 0.0, 0.0
@@ -70,7 +70,7 @@ def _image(i, j, x, y, m, hi, seg, s):
 def _corner(i, j, x, y, m, hi, seg, s1, s2):
     """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's point reflection through the
     right-angled corner of segments s1 and s2 (``floodsph.walls.images.corner_image``) seen from
-    i; (0, 0) when that image does not apply (method notes 3.1)."""
+    i; (0, 0) when that image does not apply (``docs/method.md`` §7)."""
     xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
     if not ok:
         return 0.0, 0.0

@@ -1,17 +1,17 @@
 """Accelerations: the variational pressure force with shock capturing, and the bed.
 
 Internal (pressure) acceleration with the grad-h correction (Vacondio et al. 2013 via
-Rodriguez-Paz & Bonet 2005; method notes eq. (4)), with beta_i = 2 rho_i / alpha_i:
+Rodriguez-Paz & Bonet 2005; ``docs/method.md`` §3.1), with beta_i = 2 rho_i / alpha_i:
 
     a_i^int = - sum_j m_j [ (g beta_i / (2 rho_w) + Pi_ij / 2) grad_i W(r_ij, h_i)
                           + (g beta_j / (2 rho_w) + Pi_ij / 2) grad_i W(r_ij, h_j) ]
 
-Shock capturing (parameter-free, Ata & Soulaimani, IJNMF 47 (2005) 139-159; method notes
-2.2 B), active for approaching pairs (v_ij . x_ij < 0):
+Shock capturing (parameter-free, Ata & Soulaimani, IJNMF 47 (2005) 139-159; ``docs/method.md``
+§3.2), active for approaching pairs (v_ij . x_ij < 0):
 
     Pi_ij = - cbar_ij (v_ij . x_ij) / (rhobar_ij sqrt(r_ij^2 + eta^2)),  eta^2 = 0.01 hbar^2
 
-Option "riemann" (method notes 2.2 C, SWE-SPHysics): g rho_i^2 / (2 rho_w) in the pressure
+Option "riemann" (``docs/method.md`` §3.2, SWE-SPHysics): g rho_i^2 / (2 rho_w) in the pressure
 term of both particles is replaced by the two-shock Riemann pressure p* = g rho_w d*^2 / 2
 (Toro) of the pair, solved along the pair axis.
 
@@ -41,7 +41,7 @@ the real neighbours do not (it sped up the thin front of a dam break in a 100 m 
 The same loop returns the velocity divergence used for the continuity-based density guess,
 div v_i = -(2 / alpha_i) sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i).
 
-Bed (pointwise, method notes eq. (5)):
+Bed (pointwise, ``docs/method.md`` §3.5):
 
     a_i = a_i^int - [(g + v.K.v + a_i^int . grad b) / (1 + |grad b|^2)] grad b
 
@@ -342,7 +342,7 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
 @njit(inline="always", cache=True)
 def _image_state(i, j, x, y, u, v, coef, seg, s, s2):
     """(applies, x', y', u', v', K') of j's image as seen from i (MVBP mirror particles,
-    method notes 3.1).
+    ``docs/method.md`` §7).
 
     About segment s (s2 < 0): position x_j' = 2 f_j - x_j (f_j the foot of j on the wall),
     free-slip velocity v_j' = v_j - 2 (v_j . n) n and renormalisation tensor R K_j R,

@@ -17,7 +17,7 @@ For the pressure force, (dW/dr) / r is evaluated from r, 1/r and 1/h without div
 Units: W [m^-2], dW/dr [m^-3], (dW/dr) / r [m^-4]. Support radius 2h.
 
 Reference: Monaghan & Lattanzio (1985); the 2-D normalisation 10/(7 pi h^2) as used by
-Vacondio et al., Adv. Water Resour. 58 (2013) 10-23 (method notes, section 1.3).
+Vacondio et al., Adv. Water Resour. 58 (2013) 10-23 (``docs/method.md`` §2).
 """
 
 from __future__ import annotations

@@ -1,10 +1,10 @@
 """The leap-frog's kicks, implicit Manning friction and the CFL time step (pointwise kernels).
 
-Friction (method notes 2.5), implicit Manning, :func:`friction_factor`:
+Friction (``docs/method.md`` §3.6), implicit Manning, :func:`friction_factor`:
 
     v  <- 2 v / (1 + sqrt(1 + 4 beta)),  beta = dt g n^2 |v| / max(d, d_floor)^(4/3)
 
-Time step (method notes 2.7): dt = cfl min_i h_i / (|v_i| + c_i), c_i = sqrt(g d_i).
+Time step (``docs/method.md`` §5): dt = cfl min_i h_i / (|v_i| + c_i), c_i = sqrt(g d_i).
 
 Units: velocities [m s-1], accelerations [m s-2], rho [kg m-2], h [m], dt [s].
 """
@@ -29,10 +29,10 @@ def friction_factor(u, v, rho, n, dt, d_floor):
     v_new = v - dt g n^2 |v_new| v_new / d^(4/3): v_new is parallel to v, and its speed s
     solves s + (beta / |v|) s^2 = |v|. A particle kicked by a constant acceleration a then
     keeps Manning's terminal speed, a = g n^2 |v|^2 / d^(4/3), at any dt. The point-implicit
-    factor 1 / (1 + beta) of the method notes (2.5) settles at u_e (sqrt(beta_e^2 + 4) -
-    beta_e) / 2 with beta_e = dt g n^2 u_e / d^(4/3): 5 % slow at beta_e = 0.1, which the
-    long steps of slow, thin particles under local time stepping reach on a flood plain.
-    Like it, f lies in (0, 1], so friction cannot reverse the flow, for any dt.
+    factor 1 / (1 + beta) of the reference codes (``docs/method.md`` §3.6) settles at
+    u_e (sqrt(beta_e^2 + 4) - beta_e) / 2 with beta_e = dt g n^2 u_e / d^(4/3): 5 % slow at
+    beta_e = 0.1, which the long steps of slow, thin particles under local time stepping reach
+    on a flood plain. Like it, f lies in (0, 1], so friction cannot reverse the flow, for any dt.
     """
     d = max(rho / RHO_WATER, d_floor)
     speed = math.sqrt(u * u + v * v)
