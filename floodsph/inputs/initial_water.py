@@ -33,6 +33,7 @@ from floodsph.io.polygons import check_polygon, points_in_polygon
 from floodsph.io.raster import read_grid, resample_onto
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
+from floodsph.sph.kernels import seeded_smoothing_length
 from floodsph.walls.nodata import walled_slivers
 
 LUMP_RATIO = 9.0
@@ -294,8 +295,9 @@ def particles_at(x, y, d, dx: float, kappa: float, u=0.0, v=0.0, d_min: float = 
     if particles is None:
         particles = ParticleSet(count)
     if count:
+        h0 = seeded_smoothing_length(kappa, dx)
         particles.append(x=x[keep], y=y[keep], m=RHO_WATER * d[keep] * dx**2,
-                         rho=RHO_WATER * d[keep], h=np.full(count, kappa * dx),
+                         rho=RHO_WATER * d[keep], h=np.full(count, h0),
                          u=np.broadcast_to(u, x.shape)[keep],
                          v=np.broadcast_to(v, x.shape)[keep],
                          eta_seed=np.broadcast_to(eta_seed, x.shape)[keep])

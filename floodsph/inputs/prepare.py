@@ -51,6 +51,7 @@ from floodsph.io.coordinates import inline_to_model
 from floodsph.io.raster import crs_label
 from floodsph.io.vector import is_vector_file
 from floodsph.scenario.config import Scenario
+from floodsph.sph.kernels import seeded_smoothing_length
 
 
 @dataclass
@@ -321,7 +322,7 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"({n_in} inflows)",
         f"Particles:       {inputs.particles.n}",
         f"Spacing:         {inputs.spacing_m:g} m "
-        f"(h0 = {scenario.numerics.kappa * inputs.spacing_m:g} m)",
+        f"(h0 = {seeded_smoothing_length(scenario.numerics.kappa, inputs.spacing_m):g} m)",
         f"Peak memory:     ~{format_bytes(mem.total)} (estimate, {mem.particles_peak:,} "
         f"particles at peak); available {avail}",
         f"Run time:        {estimate_run_time(scenario, inputs, run_threads(scenario)).text()}",

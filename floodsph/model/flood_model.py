@@ -33,6 +33,7 @@ from floodsph.sph import (
     consistency,
     density,
     forces,
+    kernels,
     level_momentum,
     level_offsets,
     shadow,
@@ -70,8 +71,9 @@ class FloodModel:
     seg : (k, 4) array
         Wall segments (x0, y0, x1, y1) [m] that water cannot cross
         (``floodsph.model.wall_layout.model_segments``).
-    closed_edges : bool or tuple of str
-        As given to the builder: True, False, or the closed sides.
+    closed_sides : frozenset of str
+        The closed sides of the DEM rectangle (``floodsph.model.builder.set_up_model``); with
+        any closed, the nodata border is a wall too.
     boundaries : sequence of floodsph.boundaries.protocol.Boundary
         Open boundaries (the open edges, inflows, sinks), each keeping that contract:
         ``apply`` after each drift (adding to ``volume_in`` / ``volume_out`` what they inject
@@ -95,7 +97,7 @@ class FloodModel:
     stage_timer = None  # a class default, so that models pickled before it existed load
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
-                 seg: np.ndarray, closed_edges: bool | tuple[str, ...], boundaries,
+                 seg: np.ndarray, closed_sides: frozenset[str], boundaries,
                  refiner=None, held: np.ndarray | None = None):
         self.terrain = terrain
         self.boundaries = list(boundaries)
@@ -105,9 +107,9 @@ class FloodModel:
         self.scheme = {Stabilisation.LAX_FRIEDRICHS: forces.LAX_FRIEDRICHS,
                        Stabilisation.RIEMANN: forces.RIEMANN,
                        Stabilisation.MUSCL: forces.MUSCL}[numerics.stabilisation]
-        self.closed_edges = closed_edges
+        self.closed_sides = closed_sides
         self.seg = seg
-        h0 = numerics.kappa * numerics.particle_spacing_m
+        h0 = kernels.seeded_smoothing_length(numerics.kappa, numerics.particle_spacing_m)
         self.wall_index = WallIndex(
             self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=2.0 * h0)
         self.t = 0.0
@@ -140,7 +142,7 @@ class FloodModel:
 
     def __repr__(self) -> str:
         return (f"FloodModel(t={self.t:.3f} s, steps={self.steps}, particles={self.particles.n}, "
-                f"walls={self.seg.shape[0]} segments, closed_edges={self.closed_edges})")
+                f"walls={self.seg.shape[0]} segments, closed_sides={sorted(self.closed_sides)})")
 
     # -- state -----------------------------------------------------------------------------
     def depth(self) -> np.ndarray:
@@ -228,7 +230,7 @@ class FloodModel:
         self._lap("kick_drift")
         for boundary in self.boundaries:
             boundary.apply(self, dt)
-        self.remove_outside(nodata=self.closed_edges is False)
+        self.remove_outside(nodata=not self.closed_sides)
         self._lap("boundaries")
         density.predict(p.rho, p.h, p.divv, dt)
         self._lap("density")

@@ -187,7 +187,7 @@ class Refiner:
             return idx
         h_parent = _parent_h(p, idx, model.numerics.kappa, s.refine_smoothing_excess)
         x, y, _ = _daughter_positions(p, idx, h_parent)
-        walled = model.closed_edges is not False
+        walled = bool(model.closed_sides)
         ok = model.terrain.covers(x, y, valid_only=not walled)  # walled nodata slivers are wet area
         ok = ok.reshape(-1, refine.DAUGHTERS).all(axis=1)
         wi = model.wall_index

@@ -30,6 +30,14 @@ SIGMA_2D = 10.0 / (7.0 * math.pi)
 """Normalisation constant of the 2-D cubic spline, W(0, h) = SIGMA_2D / h^2."""
 
 
+def seeded_smoothing_length(kappa, spacing):
+    """h0 = kappa dx [m]: the smoothing length of particles seeded at ``spacing`` dx [m]
+    (``numerics.kappa``, ``docs/method.md`` §2). The one place it is computed: the seeding,
+    the wall layout and index, the sinks' reach and the run-time estimate all take it here.
+    Works on numbers and arrays alike."""
+    return kappa * spacing
+
+
 @njit(inline="always", cache=True)
 def w_cubic(r, h):
     """Kernel value W(r, h) [m^-2] of the 2-D cubic spline."""
