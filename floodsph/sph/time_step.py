@@ -40,18 +40,6 @@ def friction_factor(u, v, rho, n, dt, d_floor):
     return 2.0 / (1.0 + math.sqrt(1.0 + 4.0 * beta))
 
 
-@njit(parallel=True, cache=True)
-def apply_friction(u, v, rho, manning, dt, d_floor):
-    """Implicit Manning friction over dt: v <- f v (:func:`friction_factor`); n <= 0: none."""
-    for i in prange(u.shape[0]):
-        n = manning[i]
-        if n <= 0.0:
-            continue
-        k = friction_factor(u[i], v[i], rho[i], n, dt, d_floor)
-        u[i] *= k
-        v[i] *= k
-
-
 @njit(inline="always", cache=True)
 def _dt_bound(u, v, rho, h):
     """h / (|v| + c) [s] of one particle (c = sqrt(g d)), inf if it is still and dry."""
@@ -80,8 +68,8 @@ def kick(u, v, ax, ay, half):
 @njit(parallel=True, cache=True)
 def close_step(u, v, ax, ay, half, rho, h, manning, dt, d_floor, cfl):
     """The end of a step in one pass: the closing half kick (:func:`kick`), implicit Manning
-    friction over dt (:func:`apply_friction`), and the next CFL step of :func:`stable_dt`,
-    which is returned [s]."""
+    friction over dt (v <- f v, :func:`friction_factor`; none where n <= 0), and the next CFL
+    step of :func:`stable_dt`, which is returned [s]."""
     best = np.inf
     for i in prange(u.shape[0]):
         u[i] += half * ax[i]
