@@ -169,7 +169,7 @@ class OpenEdges:
         if not p.n or not self.sides:
             return
         beyond = dict(zip(self.sides, self._beyond(p.x, p.y), strict=True))
-        groups = [(side,) for side in self.sides]
+        groups: list[tuple[str, ...]] = [(side,) for side in self.sides]
         groups += [(a, b) for a in ("west", "east") for b in ("south", "north")
                    if a in beyond and b in beyond]
         for group in groups:
@@ -238,7 +238,7 @@ class OpenEdges:
 
     def protected(self, x, y) -> np.ndarray:
         """Particles within the buffer reach of an open side (no coalescing there)."""
-        return (self._beyond(x, y) > -self.reach).any(axis=0)
+        return np.asarray((self._beyond(x, y) > -self.reach).any(axis=0))
 
     def __repr__(self) -> str:
         return (f"OpenEdges({', '.join(self.sides) or 'none'}, buffer {self.buffer['x'].size}, "

@@ -128,7 +128,8 @@ def route(setup: BreachSetup):
             def faded(t, v, threshold=threshold):
                 return outflow(t, v[0]) - threshold
 
-            faded.terminal, faded.direction = True, -1.0
+            # solve_ivp reads an event's attributes off the function
+            faded.terminal, faded.direction = True, -1.0  # type: ignore[attr-defined]
             events = faded
         sol = solve_ivp(rate, (a, b), [volume], t_eval=samples, events=events, rtol=RTOL,
                         atol=atol, max_step=max(b - a, dt))

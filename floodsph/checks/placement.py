@@ -60,7 +60,7 @@ def lonlat_hint(points, terrain) -> str:
     if not terrain.crs_wkt:
         return ""
     wkt = coordinates_wkt(terrain)
-    if pyproj.CRS.from_wkt(wkt).is_geographic:
+    if wkt is None or pyproj.CRS.from_wkt(wkt).is_geographic:
         return ""
     p = to_user(terrain, points)
     xmin, ymin, xmax, ymax = LONLAT_BOX

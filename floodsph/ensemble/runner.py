@@ -28,6 +28,7 @@ import logging
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -45,6 +46,10 @@ from floodsph.errors import InputError
 from floodsph.output.grid import OutputGrid
 from floodsph.run.manifest import now_iso
 
+if TYPE_CHECKING:
+    from floodsph.ensemble.sampling import Samples
+    from floodsph.scenario.config import Scenario
+
 log = logging.getLogger(__name__)
 
 
@@ -53,8 +58,8 @@ class EnsemblePlan:
     """An ensemble checked and ready to run (:func:`prepare_ensemble`)."""
 
     out: Path
-    base: object
-    samples: object
+    base: Scenario
+    samples: Samples
     members: list
     previous: dict | None
     setup: BaseSetup

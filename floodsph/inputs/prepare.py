@@ -30,6 +30,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from rasterio.crs import CRS
@@ -53,6 +54,10 @@ from floodsph.io.vector import is_vector_file
 from floodsph.scenario.config import Scenario
 from floodsph.sph.kernels import seeded_smoothing_length
 
+if TYPE_CHECKING:
+    from floodsph.model.particles import ParticleSet
+    from floodsph.model.terrain import Terrain
+
 
 @dataclass
 class Inputs:
@@ -66,10 +71,10 @@ class Inputs:
     second, dates), one sentence per file.
     """
 
-    terrain: object
+    terrain: Terrain
     inflows: tuple
     depth: np.ndarray
-    particles: object
+    particles: ParticleSet
     spacing_m: float
     walls: list[np.ndarray]
     sinks: list[np.ndarray]
@@ -250,6 +255,7 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
             polygon = None
         else:
             polygon = local_points(terrain, body.polygon)
+            assert body.level_m is not None  # the reader requires level_m without a depth
             d = depth_from_level(terrain, body.level_m, polygon, f"{source}: {key}.polygon", wet)
         if dry is not None and not np.any(d > 0.0):
             dry.append(dry_body_reason(terrain, wet, body, polygon, key))
@@ -272,6 +278,7 @@ def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None)
         else:
             from floodsph.breach import breach_hydrograph
 
+            assert inflow.breach is not None  # the reader requires [breach] without a CSV
             t, Q, _ = breach_hydrograph(inflow.breach)
             out.append(Hydrograph(t, Q))
     return out

@@ -42,7 +42,9 @@ def moved(terrain) -> bool:
 
 
 def _transformer(terrain, inverse: bool = False) -> pyproj.Transformer:
-    user = pyproj.CRS.from_wkt(coordinates_wkt(terrain))
+    wkt = coordinates_wkt(terrain)
+    assert wkt is not None  # only called where the coordinates are moved (:func:`moved`)
+    user = pyproj.CRS.from_wkt(wkt)
     model = pyproj.CRS.from_wkt(terrain.crs_wkt)
     return pyproj.Transformer.from_crs(model, user, always_xy=True) if inverse else \
         pyproj.Transformer.from_crs(user, model, always_xy=True)

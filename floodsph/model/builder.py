@@ -100,8 +100,10 @@ def _seeds_off_walls(model: FloodModel, walled: bool) -> None:
     """Move seeds off nodata and off wall lines (``settle_seeds``); those that cannot be moved
     are removed and counted as outflow."""
     p, t = model.particles, model.terrain
-    x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy,
-                              model.numerics.particle_spacing_m, model.seg if walled else None)
+    spacing = model.numerics.particle_spacing_m
+    assert spacing is not None  # set_up_model refuses a model without it
+    x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy, spacing,
+                              model.seg if walled else None)
     p.x[:], p.y[:] = x, y
     if lost.any():
         model.volume_out += float(p.m[lost].sum() / RHO_WATER)

@@ -137,7 +137,7 @@ class FloodModel:
         self._blocked_nl = None
         self.lists_fresh = False  # lists built in this step (or local substep)
         self._nl_here = False  # lists built at the current positions
-        self.nl = None
+        self.nl: NeighbourList | None = None
         self.dt = np.inf
 
     def __repr__(self) -> str:

@@ -12,6 +12,7 @@ import numpy as np
 
 from floodsph.boundaries import Inflow, Sink
 from floodsph.boundaries.open_edges import SIDES
+from floodsph.boundaries.protocol import Boundary
 from floodsph.model.builder import set_up_model
 from floodsph.model.refinement import Refiner
 from floodsph.scenario.config import Edges, Scenario
@@ -45,12 +46,12 @@ def _closed_sides(terrain) -> frozenset[str]:
     return frozenset(terrain.closed_sides)
 
 
-def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
+def open_boundaries(scenario: Scenario, inputs, numerics) -> list[Boundary]:
     """The ``[[inflows]]`` sections (``inputs.inflows``, in the terrain's CRS) and ``[[sinks]]``
     polygons (``inputs.sinks``, inline or from vector files) as model boundaries."""
     terrain = inputs.terrain
     source = scenario.path.name
-    out = []
+    out: list[Boundary] = []
     for i, (inflow, hydrograph) in enumerate(zip(inputs.inflows, inputs.hydrographs,
                                                  strict=True)):
         line = np.column_stack(terrain.to_local(*np.asarray(inflow.line, dtype=np.float64).T))

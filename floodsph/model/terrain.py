@@ -62,7 +62,8 @@ class Terrain:
     x0: float = 0.0
     y0: float = 0.0
     crs_wkt: str | None = None
-    valid: np.ndarray | None = None
+    # None is taken as every cell valid: __post_init__ always leaves the mask here
+    valid: np.ndarray = None  # type: ignore[assignment]
     source_crs_wkt: str | None = None
     source_scale: tuple[float, float] | None = None
     coordinates_crs_wkt: str | None = None
@@ -166,7 +167,7 @@ class Terrain:
             self.curv_xx,
             self.curv_xy,
             self.curv_yy,
-            self.manning,
+            np.asarray(self.manning),  # the grid __post_init__ made of it: no copy
         )
 
 

@@ -131,7 +131,7 @@ def point_rows(raster: Raster, points) -> list[dict]:
                "error": math.nan, "status": "outside"}
         if 0 <= i < ny and 0 <= j < nx:
             value = float(raster.data[i, j])
-            if raster.quantity.threshold and math.isnan(value):
+            if raster.quantity is not None and raster.quantity.threshold and math.isnan(value):
                 value = 0.0
             row["modelled"] = value
             row["status"] = "compared" if math.isfinite(value) else "no value"
@@ -273,6 +273,7 @@ def write_outputs(result: Comparison, out_dir) -> list:
     out_dir.mkdir(parents=True, exist_ok=True)
     m = result.model
     quantity = m.quantity
+    assert quantity is not None  # compare_maps gave both maps their quantity
     diff_path = write_north_up(out_dir / "difference.tif", result.difference.astype(np.float32),
                                m.crs, m.transform, f"{quantity.name} difference",
                                "1" if quantity.classes else quantity.units,

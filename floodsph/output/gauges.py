@@ -53,7 +53,9 @@ def read_gauge_file(path, terrain) -> GaugePoints:
     if not rows or not {"id", "x", "y"} <= set(rows[0]):
         raise InputError(f"{path}: gauge file needs the columns id, x, y; "
                          f"{header_found(text)}")
-    ids, xs, ys = [], [], []
+    ids: list[str] = []
+    xs: list[float] = []
+    ys: list[float] = []
     for line, row in enumerate(rows, start=2):
         try:
             x, y = float(row["x"]), float(row["y"])
@@ -71,9 +73,9 @@ def read_gauge_file(path, terrain) -> GaugePoints:
         ids.append(row["id"])
         xs.append(lx)
         ys.append(ly)
-    x, y = np.array(xs), np.array(ys)
-    return GaugePoints(tuple(ids), x, y, bilinear(terrain.elevation, terrain.dx, terrain.dy,
-                                                  x, y))
+    gx, gy = np.array(xs), np.array(ys)
+    return GaugePoints(tuple(ids), gx, gy, bilinear(terrain.elevation, terrain.dx, terrain.dy,
+                                                    gx, gy))
 
 
 class Gauges:
@@ -133,7 +135,7 @@ class Gauges:
             w = csv.writer(f)
             w.writerow(HEADER + ((CALENDAR_COLUMN,) if self.start is not None else ()))
             for t, gid, d, lvl, s in self.rows:
-                row = (f"{t:.3f}", gid, f"{d:.4f}", f"{lvl:.4f}", f"{s:.4f}")
+                row: tuple[str, ...] = (f"{t:.3f}", gid, f"{d:.4f}", f"{lvl:.4f}", f"{s:.4f}")
                 if self.start is not None:
                     row += (utc_text(self.start + timedelta(seconds=round(t, 3))),)
                 w.writerow(row)

@@ -116,6 +116,7 @@ def flood_maps_dataset(maps: dict, info: dict, grid, *, class_names: dict,
         long_name, units, cell_methods = info[name]
         attrs = variable_attrs(name, long_name, units, cell_methods=cell_methods,
                                grid_mapping=crs is not None)
+        data: np.ndarray
         if np.asarray(arr).dtype == np.uint8:
             attrs.update(flag_attrs(class_names[name]))
             data = np.asarray(arr, dtype=np.uint8)[::-1]

@@ -24,6 +24,7 @@ import os
 import shutil
 from collections.abc import Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from floodsph.errors import InputError
 from floodsph.io.atomic_files import TEMP_PREFIX
@@ -43,6 +44,9 @@ from floodsph.io.run_names import (
     STAGING_DIR,
 )
 from floodsph.run.manifest import MANIFEST_NAME, read_manifest
+
+if TYPE_CHECKING:
+    from filelock import BaseFileLock
 
 #: Every file name a run writes (``docs/run-folder.md``); a run's files in progress
 #: carry one of these names with a suffix (``snapshots.nc.part``, ``max_depth.tif.part``).
@@ -82,7 +86,7 @@ class RunFolder:
         self.overwrite = bool(overwrite)
         self.resume = bool(resume)
         self.staged = False
-        self._lock_file = None  # a filelock.FileLock while the folder is held
+        self._lock_file: BaseFileLock | None = None  # held while the run writes the folder
 
     # -- checks (nothing written) ------------------------------------------------------------
     def check(self) -> None:

@@ -257,7 +257,7 @@ def set_threads(threads: int) -> int:
     """Use ``threads`` numba threads (0 = all); returns the number in use."""
     import numba
 
-    available = numba.config.NUMBA_NUM_THREADS
+    available = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # set at import
     n = available if threads == 0 else min(int(threads), available)
     if threads > available:
         log.warning("%d threads asked for, %d available; using %d", threads, available, n)

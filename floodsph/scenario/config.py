@@ -114,7 +114,7 @@ class Wall:
 
     @property
     def closed(self) -> bool:
-        return self.polyline[0] == self.polyline[-1]
+        return self.polyline is not None and self.polyline[0] == self.polyline[-1]
 
 
 @dataclass(frozen=True)
@@ -222,7 +222,9 @@ class Scenario:
                  t.manning_table if isinstance(t.manning_table, Path) else None,
                  t.manning if isinstance(t.manning, Path) else None,
                  *(w.depth for w in self.initial_water),
-                 *(entry.file for entry in (*self.initial_water, *self.walls, *self.sinks)),
+                 *(entry.file for entry in self.initial_water),
+                 *(entry.file for entry in self.walls),
+                 *(entry.file for entry in self.sinks),
                  *(i.hydrograph for i in self.inflows),
                  None if self.gauges is None else self.gauges.file]
         return tuple(f for f in files if f is not None)

@@ -27,6 +27,7 @@ import os
 import pickle
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from floodsph._version import __version__
 from floodsph.errors import InputError
@@ -52,7 +53,7 @@ class Checkpoint:
 
     scenario: dict
     threads: int
-    model: object
+    model: Any
     simulation: dict
     recorders: dict
     mass_rows: list

@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -58,7 +59,7 @@ class Simulation:
         self,
         model,
         end_time: float,
-        callbacks: Sequence[tuple[Callable, object]] = (),
+        callbacks: Sequence[tuple[Callable, Any]] = (),
         max_steps: int | None = None,
         should_stop: Callable[[], bool] | None = None,
     ):
