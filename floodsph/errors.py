@@ -20,8 +20,7 @@ def warn(message: str, warnings: list[str] | None) -> None:
 
     The message is logged at WARNING level (logger ``floodsph.inputs.prepare``) and, when
     ``warnings`` is a list, appended to it (``floodsph.inputs.prepare.Inputs.warnings``, which the
-    run
-    records in ``run.json``).
+    run records in ``run.json``).
     """
     log.warning("%s", message)
     if warnings is not None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from floodsph.boundaries.open_edges import SIDES
 from floodsph.inputs.initial_water import particles_at
 from floodsph.model.builder import set_up_model
 from floodsph.model.particles import ParticleSet
@@ -24,7 +25,7 @@ def particles_with_depth(x, y, d, dx, kappa, u=0.0, v=0.0) -> ParticleSet:
 
 
 def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, manning=0.0,
-             walls=(), closed=True, **numerics):
+             walls=(), closed_sides=SIDES, **numerics):
     """A FloodModel with water given as a level (float) or a depth function d(x, y).
 
     ``numerics``: fields of its ``Numerics``; ``time_stepping`` defaults to the global step,
@@ -40,7 +41,7 @@ def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, ma
     p = particles_with_depth(x, y, np.asarray(d, dtype=float), dx, kappa)
     num = Numerics(particle_spacing_m=dx, kappa=kappa,
                    **{"time_stepping": TimeStepping.GLOBAL, **numerics})
-    return set_up_model(terrain, p, num, walls=walls, closed_edges=closed)
+    return set_up_model(terrain, p, num, walls=walls, closed_sides=closed_sides)
 
 
 def run_until(model, t_end):

@@ -190,7 +190,8 @@ def keyhole(outer: list, hole: list) -> list:
 
 def scenario_text(name: str, end_time: float, dem: str, manning: float, water: list,
                   walls: list, spacing: float) -> str:
-    """A scenario TOML (scenario-format.md): closed edges, default numerics, GeoTIFF maps."""
+    """A scenario TOML (docs/scenario-reference.md): closed edges, default numerics, GeoTIFF
+    maps."""
     from tomli_w import dumps
 
     data = {

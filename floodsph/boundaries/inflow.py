@@ -1,6 +1,6 @@
 """Inflow through a breach section: buffer layers behind the line, exact injected volume.
 
-Geometry (sph-swe-method.md section 3.2): the section is the segment A-B of length L with
+Geometry (``docs/method.md`` §8): the section is the segment A-B of length L with
 inward unit normal n (towards the domain). Behind it lies a buffer of ``n_layers`` rows of
 N = round(L / dx) ghost particles, spaced dx_l = L / N along the line and dx normal to it,
 that moves into the domain at the boundary velocity w_B. The rows sit at normal offsets
@@ -17,8 +17,8 @@ Exact volume: a row whose centre crosses at time t gets the mass rho_w (V(t') - 
 with V(t) = int_0^t Q dt the exact integral of the piecewise-linear hydrograph, V_in the volume
 injected so far and t' the time its trailing edge will have crossed. The injected volume
 therefore follows the hydrograph volume within half a row (about d_B L dx / 2) at all times,
-and equals it once the hydrograph ends. This follows the advice of
-sph-swe-method.md section 3.2 ("inject the exact mass per crossing") against the up-to-2 %
+and equals it once the hydrograph ends. Each crossing thus injects exactly the mass due
+(``docs/method.md`` §8), against the up-to-2 %
 inflow losses reported for buffer-only schemes (Water 13 (2021) 1671).
 """
 
@@ -67,7 +67,7 @@ class Inflow:
     line : (2, 2) array
         End points A, B of the section in local coordinates [m].
     hydrograph : Hydrograph
-        ``discharge(t)`` [m3/s] and ``volume(t0, t1)`` [m3] (``floodsph.inputs.hydrograph``).
+        ``discharge(t)`` [m3/s] and ``volume(t0, t1)`` [m3] (``floodsph.io.hydrograph``).
     spacing, kappa : float
         Particle spacing dx [m] and h / dx of the injected particles.
     terrain : Terrain

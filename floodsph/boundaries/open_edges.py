@@ -1,11 +1,11 @@
 """Open DEM edges: an outflow buffer of departed particles with the interior state imposed.
 
-Method (sph-swe-method.md section 3.2, outlets): fluid particles that cross an open side of the
+Method (``docs/method.md`` §8, open edges): fluid particles that cross an open side of the
 DEM rectangle leave the model - their volume is counted as outflow - and become buffer
 particles that keep moving outwards until they are farther than the kernel reach 2 h (1 + skin)
 beyond the edge. Every step the buffer takes part in the neighbour search as ghosts, and after
 the density solve each buffer particle is given the interior state, a Shepard average over its
-fluid neighbours (the "inner" state d_I, v_I of section 3.2):
+fluid neighbours (the "inner" state d_I, v_I):
 
     d_I = sum_j V_j d_j W(r_ij, h_i) / sum_j V_j W(r_ij, h_i),  V_j = m_j / rho_j,
 
@@ -169,7 +169,7 @@ class OpenEdges:
         if not p.n or not self.sides:
             return
         beyond = dict(zip(self.sides, self._beyond(p.x, p.y), strict=True))
-        groups = [(side,) for side in self.sides]
+        groups: list[tuple[str, ...]] = [(side,) for side in self.sides]
         groups += [(a, b) for a in ("west", "east") for b in ("south", "north")
                    if a in beyond and b in beyond]
         for group in groups:
@@ -238,7 +238,7 @@ class OpenEdges:
 
     def protected(self, x, y) -> np.ndarray:
         """Particles within the buffer reach of an open side (no coalescing there)."""
-        return (self._beyond(x, y) > -self.reach).any(axis=0)
+        return np.asarray((self._beyond(x, y) > -self.reach).any(axis=0))
 
     def __repr__(self) -> str:
         return (f"OpenEdges({', '.join(self.sides) or 'none'}, buffer {self.buffer['x'].size}, "

@@ -6,7 +6,7 @@ w - c < 0, leaves the domain through the section and carries the Riemann invaria
 
     w - 2 sqrt(g d) = w_I - 2 sqrt(g d_I)                                    (1)
 
-from the interior state (d_I, w_I) (sph-swe-method.md section 3.2 with the outward normal
+from the interior state (d_I, w_I) (``docs/method.md`` §8, with the outward normal
 -n). The discharge per unit width q = Q / L is the second condition,
 
     d_B w_B = q.                                                              (2)
@@ -17,7 +17,7 @@ from +inf to -inf, so (1)-(2) has exactly one root for q > 0. If that root is su
 
     d_c = (q^2 / g)^(1/3),   w_c = q / d_c                                     (3)
 
-(the design advice of sph-swe-method.md section 3.2 (a); critical depth: Chow, Open-channel
+(``docs/method.md`` §8; critical depth: Chow, Open-channel
 hydraulics, 1959, eq. 4-5 for a rectangular section).
 """
 

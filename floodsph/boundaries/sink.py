@@ -4,7 +4,8 @@ A particle is absorbed when the DEM cell it stands in has its centre inside the 
 (even-odd rule, ``floodsph.io.polygons.points_in_polygon``), so the sink edge follows the DEM
 grid. Its volume m / rho_w is added to ``model.volume_out``. Water beyond the edge of the
 model is not simulated: a sink is an absorbing boundary, which is what a receiving water body
-far larger than the flood is (flood-practice.md: model only what the scene needs).
+far larger than the flood is: only the water that floods the scene is modelled
+(``docs/method.md`` §8).
 """
 
 from __future__ import annotations

@@ -41,7 +41,7 @@ from floodsph.breach.formulas import (
 )
 from floodsph.breach.params import BreachParams, load_breach_params
 from floodsph.breach.routing import BreachSummary, breach_hydrograph
-from floodsph.inputs.hydrograph import write_hydrograph_csv
+from floodsph.io.hydrograph import write_hydrograph_csv
 
 __all__ = [
     "BreachParams",

@@ -1,8 +1,8 @@
 """Empirical dam-breach regressions and the breach weir equation (SI units throughout).
 
 Symbols: ``V_w`` reservoir volume above the breach invert at failure [m3], ``h_b`` breach height
-[m], ``h_w`` head of water above the breach invert at failure [m], g = 9.81 m/s2. Sources as
-collected in flood-practice.md §1.2 (HEC-RAS 1D Technical Reference, "Estimating breach
+[m], ``h_w`` head of water above the breach invert at failure [m], g = 9.81 m/s2. Sources in
+``docs/breach.md`` (HEC-RAS 1D Technical Reference, "Estimating breach
 parameters" and its example application; Wahl 2004, USBR DSO-04-04).
 """
 
@@ -62,9 +62,9 @@ def froehlich1995_peak(volume_m3, head_m):
 def macdonald1984_peak(volume_m3, head_m):
     """Peak breach outflow, MacDonald & Langridge-Monopolis (1984), earthfill dams [m3/s].
 
-    Q_p = 1.154 (V_w h_w)^0.412. Some secondary sources (e.g. pe-calc.com) print the
-    coefficient as 1.175; the 1.154 value is the one listed in flood-practice.md §1.2 and used
-    here. MacDonald, T.C. & Langridge-Monopolis, J. (1984) "Breaching characteristics of dam
+    Q_p = 1.154 (V_w h_w)^0.412. Some secondary sources (e.g. pe-calc.com) print the coefficient
+    as 1.175; the 1.154 value is the published one and is used here (``docs/breach.md`` §3).
+    MacDonald, T.C. & Langridge-Monopolis, J. (1984) "Breaching characteristics of dam
     failures", J. Hydraul. Eng. 110(5), 567-586.
     """
     return 1.154 * (volume_m3 * head_m) ** 0.412

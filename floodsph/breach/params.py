@@ -13,9 +13,9 @@ from pathlib import Path
 
 from floodsph.breach import formulas
 from floodsph.breach.storage import Storage, read_storage_table
+from floodsph.constants import LARGEST_VALUE
 from floodsph.errors import InputError
-from floodsph.inputs.hydrograph import Hydrograph, read_hydrograph
-from floodsph.scenario.schema import LARGEST_VALUE
+from floodsph.io.hydrograph import Hydrograph, read_hydrograph
 
 #: Relative tolerance on reservoir_volume_m3 against the volume implied by the storage input.
 VOLUME_TOLERANCE = 0.01

@@ -1,7 +1,7 @@
 """Level-pool routing of a reservoir through a growing trapezoidal breach.
 
 The reservoir storage V obeys dV/dt = Q_in(t) - Q_b(H(V), t) (HEC-RAS level-pool practice,
-flood-practice.md §1.2), with H(V) the storage-elevation curve and Q_b the free broad-crested
+``docs/breach.md`` §2), with H(V) the storage-elevation curve and Q_b the free broad-crested
 weir flow through the breach (:func:`floodsph.breach.formulas.trapezoid_weir_discharge`).
 From initiation at ``start_time_s`` the breach grows over the formation time t_f by the fraction
 r(tau) (linear or sine progression): bottom width b = r B, bottom elevation
@@ -23,7 +23,7 @@ import numpy as np
 
 from floodsph.breach import formulas
 from floodsph.breach.params import BreachParams, BreachSetup, resolve
-from floodsph.inputs.hydrograph import Hydrograph
+from floodsph.io.hydrograph import Hydrograph
 
 #: Without duration_s, the routing stops once the breach has formed and the outflow has fallen
 #: below this fraction of the peak (and the reservoir inflow has ended) ...
@@ -128,7 +128,8 @@ def route(setup: BreachSetup):
             def faded(t, v, threshold=threshold):
                 return outflow(t, v[0]) - threshold
 
-            faded.terminal, faded.direction = True, -1.0
+            # solve_ivp reads an event's attributes off the function
+            faded.terminal, faded.direction = True, -1.0  # type: ignore[attr-defined]
             events = faded
         sol = solve_ivp(rate, (a, b), [volume], t_eval=samples, events=events, rtol=RTOL,
                         atol=atol, max_step=max(b - a, dt))

@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass
 
 from floodsph.errors import InputError
-from floodsph.inputs.hydrograph import read_csv_columns
+from floodsph.io.hydrograph import read_csv_columns
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,7 +91,7 @@ def read_storage_table(path, name):
     ------
     InputError
         Naming the key, the file and the line: the generic CSV errors of
-        :func:`floodsph.inputs.hydrograph.read_csv_columns`, elevations or volumes not strictly
+        :func:`floodsph.io.hydrograph.read_csv_columns`, elevations or volumes not strictly
         increasing, negative areas, fewer than 2 rows.
     """
     values, lines = read_csv_columns(path, name, ("elevation_m",), one_of=("volume_m3", "area_m2"))

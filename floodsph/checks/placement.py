@@ -4,7 +4,7 @@ Checked once the DEM is read (:func:`check_geometry_on_dem`), each message namin
 path: every polygon and wall overlaps the DEM rectangle (a part outside is allowed: a
 reservoir outline drawn beyond a cropped DEM), every inflow line end lies on DEM data and the
 line is at least half a particle spacing long. The geometry is in the model's CRS by then
-(``floodsph.inputs.coordinates``); messages give the DEM's extent and the points in the CRS the
+(``floodsph.io.coordinates``); messages give the DEM's extent and the points in the CRS the
 inline coordinates are in, naming it, and name geometry that looks like longitude/latitude
 where that CRS is projected (:func:`lonlat_hint`).
 """
@@ -16,7 +16,7 @@ import pyproj
 import shapely
 
 from floodsph.errors import InputError
-from floodsph.inputs.coordinates import coordinates_label, coordinates_wkt, moved, to_user
+from floodsph.io.coordinates import coordinates_label, coordinates_wkt, moved, to_user
 
 INFLOW_MIN_SPACINGS = 0.5
 """An inflow line shorter than this many particle spacings is refused: its buffer rows hold
@@ -60,7 +60,7 @@ def lonlat_hint(points, terrain) -> str:
     if not terrain.crs_wkt:
         return ""
     wkt = coordinates_wkt(terrain)
-    if pyproj.CRS.from_wkt(wkt).is_geographic:
+    if wkt is None or pyproj.CRS.from_wkt(wkt).is_geographic:
         return ""
     p = to_user(terrain, points)
     xmin, ymin, xmax, ymax = LONLAT_BOX

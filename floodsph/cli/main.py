@@ -120,7 +120,7 @@ def _configure_logging(verbose: int, quiet: bool) -> None:
         if getattr(handler, "_floodsph_console", False):
             logger.removeHandler(handler)
     handler = logging.StreamHandler()
-    handler._floodsph_console = True
+    handler._floodsph_console = True  # type: ignore[attr-defined]  # our handler's mark
     handler.addFilter(lambda record: not getattr(record, "file_only", False))
     handler.setLevel(level)
     handler.setFormatter(logging.Formatter("%(levelname)s: %(message)s"))

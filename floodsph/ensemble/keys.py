@@ -155,7 +155,7 @@ def base_value(data: dict, key: KeyPath):
     params = BreachParams.from_mapping(table, f"inflows[{index}].breach")
     if name in ("average_width_m", "formation_time_s"):
         return float(getattr(resolve(params), name))
-    default = getattr(params, name)
+    default = getattr(params, str(name))
     return MISSING if default is None else default
 
 

@@ -17,7 +17,7 @@ ones), ``"interrupted"`` or ``"failed"`` (no member completed, or the ensemble i
 ``interrupted`` for one running when the ensemble was interrupted -- or ``"not run"``),
 ``wall_time_s``, ``error``.
 
-Both files are written atomically (``floodsph.run.atomic_files``), readable by the group.
+Both files are written atomically (``floodsph.io.atomic_files``), readable by the group.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import json
 from pathlib import Path
 
 from floodsph._version import __version__
-from floodsph.run.atomic_files import atomic_path
+from floodsph.io.atomic_files import atomic_path
 from floodsph.run.manifest import json_safe, now_iso
 
 ENSEMBLE_JSON = "ensemble.json"

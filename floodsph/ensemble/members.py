@@ -29,6 +29,7 @@ import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from floodsph.ensemble.keys import MISSING, KeyPath, KeyPathError, assign, base_value, lookup
 from floodsph.ensemble.manifest import NOT_RUN
@@ -58,7 +59,7 @@ class Binding:
     multiplies (None in value mode); ``raster`` is True for a raster scaled by a factor."""
 
     parameter: Parameter
-    base: object
+    base: Any
     raster: bool
 
     def value(self, drawn):

@@ -26,11 +26,12 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from floodsph.ensemble.aggregate import UK_CLASSES, EnsembleMaps
-from floodsph.run.atomic_files import atomic_path
+from floodsph.io.atomic_files import atomic_path
 
 #: variable -> (dimension, long name, units)
 VARIABLES = {
@@ -76,7 +77,7 @@ def write_ensemble_netcdf(path, maps: EnsembleMaps, grid, *, ensemble: dict,
         encoding["crs"] = {"dtype": "int32"}
     chunks = (1, min(grid.ny, 256), min(grid.nx, 256))
     for name, (dim, long_name, units) in VARIABLES.items():
-        attrs = {"long_name": long_name, "units": units}
+        attrs: dict[str, Any] = {"long_name": long_name, "units": units}
         if crs is not None:
             attrs["grid_mapping"] = "crs"
         if units == "1":
@@ -85,7 +86,7 @@ def write_ensemble_netcdf(path, maps: EnsembleMaps, grid, *, ensemble: dict,
         data_vars[name] = xr.Variable((dim, "y", "x"), data, attrs)
         encoding[name] = {"dtype": "float32", "_FillValue": np.float32(np.nan), "zlib": True,
                           "complevel": 4, "chunksizes": chunks}
-    attrs = global_attrs("floodsph ensemble maps", scenario, wet_threshold)
+    attrs = dict[str, Any](global_attrs("floodsph ensemble maps", scenario, wet_threshold))
     attrs["ensemble"] = json.dumps(ensemble, sort_keys=True)
     attrs["members_completed"] = int(maps.members)
     ds = xr.Dataset(data_vars, coords=coords, attrs=attrs)

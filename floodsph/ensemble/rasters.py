@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from floodsph.errors import InputError
-from floodsph.run.atomic_files import atomic_path
+from floodsph.io.atomic_files import atomic_path
 
 #: Key patterns whose value may be a raster file that a factor scales.
 RASTER_KEYS = ("terrain.manning", "initial_water[].depth")

@@ -28,6 +28,7 @@ import logging
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -45,6 +46,10 @@ from floodsph.errors import InputError
 from floodsph.output.grid import OutputGrid
 from floodsph.run.manifest import now_iso
 
+if TYPE_CHECKING:
+    from floodsph.ensemble.sampling import Samples
+    from floodsph.scenario.config import Scenario
+
 log = logging.getLogger(__name__)
 
 
@@ -53,8 +58,8 @@ class EnsemblePlan:
     """An ensemble checked and ready to run (:func:`prepare_ensemble`)."""
 
     out: Path
-    base: object
-    samples: object
+    base: Scenario
+    samples: Samples
     members: list
     previous: dict | None
     setup: BaseSetup
@@ -215,7 +220,7 @@ def check_extreme_members(spec: EnsembleSpec, plan: EnsemblePlan) -> list[str]:
 def _record_interrupted(to_run, results: dict, reason: str) -> None:
     """Members that were running when the ensemble was interrupted: ``interrupted`` in
     ``results`` and in their own ``run.json`` (left at ``running`` by the closed worker)."""
-    from floodsph.run.folder import STAGING_DIR
+    from floodsph.io.run_names import STAGING_DIR
     from floodsph.run.manifest import read_manifest, write_manifest
 
     for member in to_run:

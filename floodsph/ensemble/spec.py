@@ -130,7 +130,7 @@ def ensemble_from_dict(data: dict, *, source: str, base_dir: Path) -> EnsembleSp
     if not name.strip() or name in (".", "..") or any(c in name for c in "/\\:"):
         raise r.fail(join(p, "name"), f"must be a non-empty folder name without / \\ :, got "
                                       f"{name!r}")
-    parameters = []
+    parameters: list[Parameter] = []
     for i, table in enumerate(r.table_array(t, "parameters")):
         parameter = _parameter(r, table, join(join(p, "parameters"), i))
         if any(q.key.text == parameter.key.text for q in parameters):
@@ -198,7 +198,7 @@ def _numbers(r: Reader, table: dict, where: str, key: str, default: tuple, label
     values = table[key]
     if not isinstance(values, list) or not values:
         raise r.fail(path, f"expected a non-empty array of numbers, got {describe(values)}")
-    out = []
+    out: list[float] = []
     for k, v in enumerate(values):
         inside = is_number(v) and (v > low if low_open else v >= low) and v < high
         if not inside:

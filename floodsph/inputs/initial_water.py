@@ -33,6 +33,7 @@ from floodsph.io.polygons import check_polygon, points_in_polygon
 from floodsph.io.raster import read_grid, resample_onto
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
+from floodsph.sph.kernels import seeded_smoothing_length
 from floodsph.walls.nodata import walled_slivers
 
 LUMP_RATIO = 9.0
@@ -44,7 +45,7 @@ def wet_cells(terrain: Terrain, walled: bool) -> np.ndarray:
     """The cells initial water may fill: the valid ones, and where the nodata border is walled
     (closed edges) the nodata slivers inside its simplified walls
     (:func:`floodsph.walls.nodata.walled_slivers`), which the water reaches in the
-    model as well; their bed is the nearest valid elevation (``floodsph.io.dem``)."""
+    model as well; their bed is the nearest valid elevation (``floodsph.inputs.dem``)."""
     if not walled:
         return terrain.valid
     return terrain.valid | walled_slivers(terrain.valid, terrain.dx, terrain.dy)
@@ -86,7 +87,7 @@ def depth_from_level(
 def stray_slivers(inside: np.ndarray, valid: np.ndarray) -> np.ndarray:
     """The nodata cells of ``inside`` whose nearest valid cell is not inside: (ny, nx) bool.
 
-    A nodata sliver takes the bed of its nearest valid cell (``floodsph.io.dem``) and belongs
+    A nodata sliver takes the bed of its nearest valid cell (``floodsph.inputs.dem``) and belongs
     to that cell's side of the walls (:func:`floodsph.walls.nodata.walled_slivers`). A polygon
     may hold the sliver but not that cell: on Malpasset's 20 m DEM the slivers of a side
     valley beyond the dam, 1-2 cells from the reservoir across the nodata, took the valley's bed
@@ -191,7 +192,7 @@ def lump_thin_cells(d: np.ndarray, ratio: float = LUMP_RATIO) -> np.ndarray:
     sqrt(ratio) or more times smaller than theirs. Such particles set the time step of the
     whole run (a reservoir's shore seeds of a few cm, whose h falls to the h0 / h_ratio bound
     when the flood carries them into metres of water), and neighbour h ratios above about 2-3
-    degrade accuracy (method notes, section 7). Where the water is that thin the shore moves
+    degrade accuracy (``docs/method.md`` §1). Where the water is that thin the shore moves
     inwards, by one spacing, or more where a cell that received water is in turn lumped.
     """
     d = d.copy()
@@ -294,8 +295,9 @@ def particles_at(x, y, d, dx: float, kappa: float, u=0.0, v=0.0, d_min: float = 
     if particles is None:
         particles = ParticleSet(count)
     if count:
+        h0 = seeded_smoothing_length(kappa, dx)
         particles.append(x=x[keep], y=y[keep], m=RHO_WATER * d[keep] * dx**2,
-                         rho=RHO_WATER * d[keep], h=np.full(count, kappa * dx),
+                         rho=RHO_WATER * d[keep], h=np.full(count, h0),
                          u=np.broadcast_to(u, x.shape)[keep],
                          v=np.broadcast_to(v, x.shape)[keep],
                          eta_seed=np.broadcast_to(eta_seed, x.shape)[keep])

@@ -22,8 +22,7 @@ Bytes, at the larger of the two peaks (seeding, then the run)::
   rasters);
 * SEEDING = cells_lattice * SEEDING_ARRAYS * 8: the initial water is seeded on a dense
   lattice of the particle spacing over the whole DEM (``floodsph.inputs.initial_water``): the
-  lattice
-  depths, their padded copy, the 8 shifted neighbour grids stacked, the deepest neighbour
+  lattice depths, their padded copy, the 8 shifted neighbour grids stacked, the deepest neighbour
   and the masks. ``tracemalloc`` measured a peak of 12.3-13.0 float64 per lattice cell
   (lattices of 1.6e5 and 6.4e5 cells, 1 % wet); 14 errs high;
 * per particle: the 13 float64/int64 particle arrays held twice (capacity doubles when it

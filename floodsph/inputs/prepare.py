@@ -6,7 +6,7 @@ created (``floodsph check`` stops after it and prints :func:`summary_lines`):
 1. read or route the inflow hydrographs and integrate them up to the end time;
 2. read the DEM's header and refuse a run too large for the memory available, from the grid
    shapes alone (``floodsph.inputs.memory``), before any grid is allocated;
-3. load the DEM and roughness (``floodsph.io.dem.load_terrain``: fill values, feet, Manning
+3. load the DEM and roughness (``floodsph.inputs.dem.load_terrain``: fill values, feet, Manning
    values that are Strickler coefficients);
 4. read the geometry given as vector files, reprojected into the DEM's CRS
    (``floodsph.inputs.vectors``), and check that all of it lies on the DEM
@@ -30,6 +30,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from rasterio.crs import CRS
@@ -38,7 +39,6 @@ from floodsph.checks.inflows import check_inflows
 from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
-from floodsph.inputs.coordinates import inline_to_model
 from floodsph.inputs.memory import (
     MemoryEstimate,
     check_memory,
@@ -48,9 +48,15 @@ from floodsph.inputs.memory import (
 )
 from floodsph.inputs.run_time import estimate_run_time, run_threads, warn_if_huge
 from floodsph.inputs.vectors import vector_gauges, with_vector_geometry
+from floodsph.io.coordinates import inline_to_model
 from floodsph.io.raster import crs_label
 from floodsph.io.vector import is_vector_file
 from floodsph.scenario.config import Scenario
+from floodsph.sph.kernels import seeded_smoothing_length
+
+if TYPE_CHECKING:
+    from floodsph.model.particles import ParticleSet
+    from floodsph.model.terrain import Terrain
 
 
 @dataclass
@@ -59,16 +65,16 @@ class Inputs:
 
     ``walls`` (polylines) and ``sinks`` (polygons) are (k, 2) arrays, inline ones and those
     read from vector files alike. ``inflows`` are the scenario's ``[[inflows]]`` with their
-    line and direction in the terrain's CRS (``floodsph.inputs.coordinates``). ``warnings``
+    line and direction in the terrain's CRS (``floodsph.io.coordinates``). ``warnings``
     lists the inputs accepted with a warning (each also logged at WARNING); ``conversions``
     the units the input files were converted from (hydrographs in hours or cubic feet per
     second, dates), one sentence per file.
     """
 
-    terrain: object
+    terrain: Terrain
     inflows: tuple
     depth: np.ndarray
-    particles: object
+    particles: ParticleSet
     spacing_m: float
     walls: list[np.ndarray]
     sinks: list[np.ndarray]
@@ -85,8 +91,8 @@ class Inputs:
 def prepare_inputs(scenario: Scenario) -> Inputs:
     """Load and check everything a run needs; raises ``InputError`` on bad input, including a
     run whose memory estimate exceeds the memory available (before allocating it)."""
+    from floodsph.inputs.dem import load_terrain
     from floodsph.inputs.initial_water import seed_particles, wet_cells
-    from floodsph.io.dem import load_terrain
 
     tc = scenario.terrain
     source = str(scenario.path.name)
@@ -216,7 +222,7 @@ def estimate_before_reading(scenario: Scenario, volume_inflow_m3: float,
     the DEM's grids, the rasters read (``read_cells``, default :func:`cells_read`), the map
     grids, the seeding lattice and the inflow particles (no initial particles yet: they need
     the depth grid)."""
-    from floodsph.io.dem import check_dem_size, planned_grid
+    from floodsph.inputs.dem import check_dem_size, planned_grid
     from floodsph.io.mosaic import read_dem_header, tile_names
 
     tc = scenario.terrain
@@ -249,6 +255,7 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
             polygon = None
         else:
             polygon = local_points(terrain, body.polygon)
+            assert body.level_m is not None  # the reader requires level_m without a depth
             d = depth_from_level(terrain, body.level_m, polygon, f"{source}: {key}.polygon", wet)
         if dry is not None and not np.any(d > 0.0):
             dry.append(dry_body_reason(terrain, wet, body, polygon, key))
@@ -257,10 +264,10 @@ def initial_depth(scenario: Scenario, terrain, wet=None, dry: list[str] | None =
 
 
 def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None) -> list:
-    """One :class:`~floodsph.inputs.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
+    """One :class:`~floodsph.io.hydrograph.Hydrograph` per ``[[inflows]]``: its CSV read (the
     one place it is read; dates count from ``scenario.start``), or its breach (validated by
     ``floodsph.scenario.config``) routed. ``conversions`` receives the units converted."""
-    from floodsph.inputs.hydrograph import Hydrograph, read_hydrograph
+    from floodsph.io.hydrograph import Hydrograph, read_hydrograph
 
     source = str(scenario.path.name)
     out = []
@@ -271,6 +278,7 @@ def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None)
         else:
             from floodsph.breach import breach_hydrograph
 
+            assert inflow.breach is not None  # the reader requires [breach] without a CSV
             t, Q, _ = breach_hydrograph(inflow.breach)
             out.append(Hydrograph(t, Q))
     return out
@@ -279,7 +287,7 @@ def inflow_hydrographs(scenario: Scenario, conversions: list[str] | None = None)
 def crs_lines(terrain) -> list[str]:
     """The ``check`` lines on the CRSs: the model's and the maps' (with its scale factors over
     the domain), the DEM file's when it differs, and the one of the inline coordinates."""
-    from floodsph.inputs.coordinates import coordinates_label
+    from floodsph.io.coordinates import coordinates_label
     from floodsph.io.crs import scale_range
 
     if not terrain.crs_wkt:
@@ -321,7 +329,7 @@ def summary_lines(scenario: Scenario, inputs: Inputs, available: int | None) -> 
         f"({n_in} inflows)",
         f"Particles:       {inputs.particles.n}",
         f"Spacing:         {inputs.spacing_m:g} m "
-        f"(h0 = {scenario.numerics.kappa * inputs.spacing_m:g} m)",
+        f"(h0 = {seeded_smoothing_length(scenario.numerics.kappa, inputs.spacing_m):g} m)",
         f"Peak memory:     ~{format_bytes(mem.total)} (estimate, {mem.particles_peak:,} "
         f"particles at peak); available {avail}",
         f"Run time:        {estimate_run_time(scenario, inputs, run_threads(scenario)).text()}",

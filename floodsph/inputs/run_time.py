@@ -32,6 +32,7 @@ import numpy as np
 
 from floodsph.constants import GRAVITY
 from floodsph.errors import warn
+from floodsph.sph.kernels import seeded_smoothing_length
 
 #: Particle-steps per second of one thread: (slow, fast).
 THROUGHPUT_PER_THREAD = (0.25e6, 1.0e6)
@@ -72,7 +73,7 @@ def estimate_run_time(scenario, inputs, threads: int) -> RunTimeEstimate:
         q = float(np.max(hydrograph.Q)) / max(length, spacing)
         depth = max(depth, (q * q / GRAVITY) ** (1.0 / 3.0))
     speed = 2.0 * math.sqrt(GRAVITY * max(depth, 0.1))
-    dt = scenario.numerics.cfl * scenario.numerics.kappa * spacing / speed
+    dt = scenario.numerics.cfl * seeded_smoothing_length(scenario.numerics.kappa, spacing) / speed
     steps = max(1, math.ceil(scenario.end_time_s / dt))
     particles = (max(inputs.particles.n, 1), max(inputs.memory.particles_peak,
                                                  inputs.particles.n, 1))

@@ -1,6 +1,7 @@
 """Manning's n on the DEM grid: a constant, an n raster, or land cover + a class table.
 
-Forms (flood-practice.md §1.1, as in AutoRoutePy and HydroMT mapping tables):
+Forms (``docs/scenario-reference.md``, ``[terrain]``; as in AutoRoutePy and HydroMT mapping
+tables):
 
 * a number: uniform n [s m^-1/3];
 * a raster of n on any grid / CRS: reprojected onto the DEM grid, bilinear resampling;
@@ -10,11 +11,11 @@ Forms (flood-practice.md §1.1, as in AutoRoutePy and HydroMT mapping tables):
   ESA WorldCover classes (``floodsph/data/worldcover_manning.csv``, textbook values).
 
 Every valid DEM cell the DEM file holds must end up with a finite n > 0, else one InputError.
-Cells of the interior DEM holes that were filled by interpolation (``floodsph.io.dem``) take
+Cells of the interior DEM holes that were filled by interpolation (``floodsph.inputs.dem``) take
 the n (or land-cover class) of the nearest cell that has one, with a warning giving the count:
 a roughness raster derived from the DEM has the DEM's holes. Values that are Strickler or Chezy
 coefficients (n >= 1) are refused and unusually high ones (n > 0.2) warned of
-(:mod:`floodsph.checks.roughness`). Tables are UTF-8 CSV, with or without a BOM.
+(:mod:`floodsph.io.roughness`). Tables are UTF-8 CSV, with or without a BOM.
 """
 
 from __future__ import annotations
@@ -30,15 +31,15 @@ from rasterio.enums import Resampling
 from rasterio.transform import Affine
 from scipy import ndimage
 
-from floodsph.checks.roughness import (
+from floodsph.errors import InputError, warn
+from floodsph.io.raster import resample_onto
+from floodsph.io.roughness import (
     N_DEFAULT,
     N_STRICKLER,
     check_manning_grid,
     check_manning_number,
     strickler_text,
 )
-from floodsph.errors import InputError, warn
-from floodsph.io.raster import resample_onto
 from floodsph.io.text import read_text
 
 WORLDCOVER = "worldcover"

@@ -2,12 +2,11 @@
 
 Free global DEMs (SRTM, Copernicus GLO-30, ALOS, FABDEM) come in 1-degree tiles, and a study
 area often crosses a tile edge. Each tile is read as any raster
-(:func:`floodsph.io.raster.read_grid`: its own nodata value becomes NaN, so tiles may differ
-in it); a tile in another CRS than the
-first is reprojected (bilinear) to the first one's at the first one's cell size, with a
-warning; then ``rasterio.merge.merge`` lays them on the first tile's grid over the union of
-their bounds, the first tile that has data winning where tiles overlap. Cells no tile covers
-are nodata.
+(:func:`floodsph.io.raster.read_grid`: its own nodata value becomes NaN, so tiles may differ in
+it); a tile in another CRS than the first is reprojected (bilinear) to the first one's at the
+first one's cell size, with a warning; then ``rasterio.merge.merge`` lays them on the first
+tile's grid over the union of their bounds, the first tile that has data winning where tiles
+overlap. Cells no tile covers are nodata.
 
 A GDAL VRT mosaic (``gdalbuildvrt dem.vrt tiles/*.tif``) is read as one file and works too.
 """
@@ -26,7 +25,7 @@ from rasterio.transform import Affine
 from rasterio.warp import calculate_default_transform, reproject, transform_bounds
 
 from floodsph.errors import InputError, warn
-from floodsph.io.raster import Grid, GridHeader, crs_label, read_grid, read_header
+from floodsph.io.raster import Grid, GridHeader, crs_label, crs_wkt, read_grid, read_header
 
 
 def read_dem_grid(dem, *, variable=None, crs=None, warnings=None) -> Grid:
@@ -47,8 +46,8 @@ def read_dem_grid(dem, *, variable=None, crs=None, warnings=None) -> Grid:
     on_first = [tiles[0]]
     for path, tile in zip(dem[1:], tiles[1:], strict=True):
         if tile.crs != first.crs:
-            warn(f"DEM tile {path} is in {crs_label(tile.crs.to_wkt())}, the first tile "
-                 f"{dem[0].name} in {crs_label(first.crs.to_wkt())}; reprojected to the "
+            warn(f"DEM tile {path} is in {crs_label(crs_wkt(tile.crs))}, the first tile "
+                 f"{dem[0].name} in {crs_label(crs_wkt(first.crs))}; reprojected to the "
                  "first one's", warnings)
             tile = _reprojected(tile, first)
         on_first.append(tile)

@@ -2,7 +2,7 @@
 
 Every reader here turns rasterio/GDAL failures into one :class:`~floodsph.errors.InputError`
 that names the file, and every grid is handled *north-up* (row 0 = north, as rasterio
-returns it). Only :func:`floodsph.io.dem.load_terrain` flips to the solver's south-up order.
+returns it). Only :func:`floodsph.inputs.dem.load_terrain` flips to the solver's south-up order.
 """
 
 from __future__ import annotations
@@ -84,6 +84,11 @@ def parse_crs(value, what: str) -> CRS:
         ) from None
 
 
+def crs_wkt(crs: CRS | None) -> str | None:
+    """The WKT of ``crs``; None for a raster without one."""
+    return None if crs is None else crs.to_wkt()
+
+
 def crs_label(crs_wkt: str | None) -> str:
     """``'EPSG:32632 (WGS 84 / UTM zone 32N)'`` from a WKT (name only if there is no code)."""
     if not crs_wkt:
@@ -153,7 +158,8 @@ def read_grid(path, *, variable: str | None = None, crs=None, what: str = "raste
     used = own if crs is None else parse_crs(crs, f"{what} {path}: crs")
     if own is not None and own != used:
         warn(f"{what} {path}: its own CRS is overridden by crs={crs}", warnings)
-    return Grid(*_north_up(values, transform, path, what), used, units, nodata)
+    values, transform = _north_up(values, transform, path, what)
+    return Grid(values, transform, used, units, nodata)
 
 
 def read_header(path, *, variable: str | None = None, crs=None, what: str = "raster"

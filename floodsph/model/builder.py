@@ -6,7 +6,7 @@ step. In order:
 1. the closed sides are checked, and the open ones get transmissive ghosts
    (``floodsph.boundaries.OpenEdges``) ahead of the other boundaries;
 2. the wall segments are laid out: the scenario's walls, the closed DEM border and the
-   nodata banks, with the boundaries' openings cut out (``floodsph.walls.layout``);
+   nodata banks, with the boundaries' openings cut out (``floodsph.model.wall_layout``);
 3. the boundaries act once at t = 0 (an inflow fills its buffer);
 4. seeds are moved off nodata and wall lines (``floodsph.walls.nodata.settle_seeds``), and
    those off the grid (or on open nodata) removed as outflow;
@@ -21,20 +21,23 @@ step. In order:
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
 from floodsph.boundaries.open_edges import OpenEdges
 from floodsph.constants import RHO_WATER
 from floodsph.model.flood_model import FloodModel
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
+from floodsph.model.wall_layout import model_segments
 from floodsph.model.wall_seeds import settle_at_walls
 from floodsph.scenario.numerics import Numerics
-from floodsph.walls.layout import model_segments
+from floodsph.sph.kernels import seeded_smoothing_length
 from floodsph.walls.nodata import settle_seeds
 
 
 def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, walls=(),
-                 closed_edges: bool | tuple[str, ...] = True, boundaries=(),
+                 closed_sides: Iterable[str] = OPEN_SIDES, boundaries=(),
                  refiner=None, held=None) -> FloodModel:
     """A FloodModel ready for its first step (module docstring).
 
@@ -48,11 +51,12 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
         The solver's settings, with ``particle_spacing_m`` given.
     walls : sequence of (k, 2) arrays
         Polylines in local coordinates [m] that water cannot cross.
-    closed_edges : bool or collection of str
-        True: the DEM border and nodata areas are walls. False: water reaching them leaves
-        the model and is counted in ``volume_out``; the open sides get transmissive ghosts. A
-        collection of sides (``"west"``, ``"east"``, ``"south"``, ``"north"``) closes those
-        sides and opens the others; nodata borders are then walls.
+    closed_sides : collection of str
+        The sides of the DEM rectangle (``"west"``, ``"east"``, ``"south"``, ``"north"``) that
+        are walls; by default all four. Water reaching an open side leaves the model and is
+        counted in ``volume_out``; the open sides get transmissive ghosts. Where any side is
+        closed the nodata borders are walls too; with none closed, water entering nodata
+        leaves the model.
     boundaries : sequence of floodsph.boundaries.protocol.Boundary
         Open boundaries (inflows, sinks).
     refiner : floodsph.model.refinement.Refiner or None
@@ -63,20 +67,20 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
         raise ValueError("set_up_model: numerics.particle_spacing_m must be given (the "
                          "scenario's default, the DEM cell size, is filled in by "
                          "floodsph.model.from_scenario.build_model)")
-    closed = set(OPEN_SIDES) if closed_edges is True else set(closed_edges or ())
+    closed = frozenset(closed_sides)
     unknown = closed - set(OPEN_SIDES)
-    if unknown:
-        raise ValueError(f"closed_edges: unknown sides {sorted(unknown)}; use {OPEN_SIDES}")
+    if unknown or isinstance(closed_sides, str):
+        raise ValueError(f"closed_sides: unknown sides {sorted(unknown)}; use {OPEN_SIDES}")
     boundaries = list(boundaries)
     open_sides = [side for side in OPEN_SIDES if side not in closed]
     if open_sides:
         boundaries.insert(0, OpenEdges(terrain.width, terrain.height, open_sides))
     openings = [b.opening for b in boundaries if b.opening is not None]
-    walled = closed_edges is not False
+    walled = bool(closed)
     seg = model_segments(terrain, walls, closed, walled, openings,
-                         numerics.kappa * numerics.particle_spacing_m,
+                         seeded_smoothing_length(numerics.kappa, numerics.particle_spacing_m),
                          numerics.particle_spacing_m)
-    model = FloodModel(terrain, particles, numerics, seg, closed_edges, boundaries, refiner,
+    model = FloodModel(terrain, particles, numerics, seg, closed, boundaries, refiner,
                        held)
     for boundary in model.boundaries:
         boundary.apply(model, 0.0)
@@ -96,8 +100,10 @@ def _seeds_off_walls(model: FloodModel, walled: bool) -> None:
     """Move seeds off nodata and off wall lines (``settle_seeds``); those that cannot be moved
     are removed and counted as outflow."""
     p, t = model.particles, model.terrain
-    x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy,
-                              model.numerics.particle_spacing_m, model.seg if walled else None)
+    spacing = model.numerics.particle_spacing_m
+    assert spacing is not None  # set_up_model refuses a model without it
+    x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy, spacing,
+                              model.seg if walled else None)
     p.x[:], p.y[:] = x, y
     if lost.any():
         model.volume_out += float(p.m[lost].sum() / RHO_WATER)

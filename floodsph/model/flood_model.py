@@ -2,7 +2,7 @@
 
 The model knows how to take a step and nothing about files, schedules or output (those are
 ``floodsph.simulation.loop``'s). One step (kick-drift-kick leap-frog with a variable CFL step,
-method notes 2.6-2.7):
+``docs/method.md`` §5):
 
 1. kick   v^{n+1/2} = v^n + a^n dt / 2
 2. drift  x^{n+1} = x^n + v^{n+1/2} dt; moves across walls are reflected; particles that
@@ -33,8 +33,10 @@ from floodsph.sph import (
     consistency,
     density,
     forces,
+    kernels,
     level_momentum,
     level_offsets,
+    shadow,
     shore,
     time_step,
 )
@@ -42,7 +44,7 @@ from floodsph.sph.cells import CellGrid
 from floodsph.sph.neighbours import NeighbourList
 from floodsph.sph.sums import SUMS
 from floodsph.sph.velocity_gradient import velocity_gradient
-from floodsph.walls import shadow, sight
+from floodsph.walls import sight
 from floodsph.walls.index import WallIndex, WallLists
 
 MAX_SEARCH_GROWTH = 2.0
@@ -68,9 +70,10 @@ class FloodModel:
         given.
     seg : (k, 4) array
         Wall segments (x0, y0, x1, y1) [m] that water cannot cross
-        (``floodsph.walls.layout.model_segments``).
-    closed_edges : bool or tuple of str
-        As given to the builder: True, False, or the closed sides.
+        (``floodsph.model.wall_layout.model_segments``).
+    closed_sides : frozenset of str
+        The closed sides of the DEM rectangle (``floodsph.model.builder.set_up_model``); with
+        any closed, the nodata border is a wall too.
     boundaries : sequence of floodsph.boundaries.protocol.Boundary
         Open boundaries (the open edges, inflows, sinks), each keeping that contract:
         ``apply`` after each drift (adding to ``volume_in`` / ``volume_out`` what they inject
@@ -94,7 +97,7 @@ class FloodModel:
     stage_timer = None  # a class default, so that models pickled before it existed load
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
-                 seg: np.ndarray, closed_edges: bool | tuple[str, ...], boundaries,
+                 seg: np.ndarray, closed_sides: frozenset[str], boundaries,
                  refiner=None, held: np.ndarray | None = None):
         self.terrain = terrain
         self.boundaries = list(boundaries)
@@ -104,9 +107,9 @@ class FloodModel:
         self.scheme = {Stabilisation.LAX_FRIEDRICHS: forces.LAX_FRIEDRICHS,
                        Stabilisation.RIEMANN: forces.RIEMANN,
                        Stabilisation.MUSCL: forces.MUSCL}[numerics.stabilisation]
-        self.closed_edges = closed_edges
+        self.closed_sides = closed_sides
         self.seg = seg
-        h0 = numerics.kappa * numerics.particle_spacing_m
+        h0 = kernels.seeded_smoothing_length(numerics.kappa, numerics.particle_spacing_m)
         self.wall_index = WallIndex(
             self.seg, (0.0, 0.0, terrain.width, terrain.height), bucket=2.0 * h0)
         self.t = 0.0
@@ -134,12 +137,12 @@ class FloodModel:
         self._blocked_nl = None
         self.lists_fresh = False  # lists built in this step (or local substep)
         self._nl_here = False  # lists built at the current positions
-        self.nl = None
+        self.nl: NeighbourList | None = None
         self.dt = np.inf
 
     def __repr__(self) -> str:
         return (f"FloodModel(t={self.t:.3f} s, steps={self.steps}, particles={self.particles.n}, "
-                f"walls={self.seg.shape[0]} segments, closed_edges={self.closed_edges})")
+                f"walls={self.seg.shape[0]} segments, closed_sides={sorted(self.closed_sides)})")
 
     # -- state -----------------------------------------------------------------------------
     def depth(self) -> np.ndarray:
@@ -229,7 +232,7 @@ class FloodModel:
         self._lap("kick_drift")
         for boundary in self.boundaries:
             boundary.apply(self, dt)
-        self.remove_outside(nodata=self.closed_edges is False)
+        self.remove_outside(nodata=not self.closed_sides)
         self._lap("boundaries")
         density.predict(p.rho, p.h, p.divv, dt)
         self._lap("density")
@@ -362,7 +365,7 @@ class FloodModel:
     def wall_lists(self) -> WallLists:
         """The walls as the density and force kernels take them: with ``wall_model =
         "integral"`` no segment makes images (its distance infinite, no corners), and the
-        walls act through ``floodsph.walls.shadow``."""
+        walls act through ``floodsph.sph.shadow``."""
         wstart, wseg, cstart, cpair = self.walls_near
         if not self.integral_walls:
             return WallLists(self.seg, self.wdist, wstart, wseg, cstart, cpair)

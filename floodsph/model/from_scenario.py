@@ -11,9 +11,12 @@ from dataclasses import replace
 import numpy as np
 
 from floodsph.boundaries import Inflow, Sink
+from floodsph.boundaries.open_edges import SIDES
+from floodsph.boundaries.protocol import Boundary
 from floodsph.model.builder import set_up_model
 from floodsph.model.refinement import Refiner
 from floodsph.scenario.config import Edges, Scenario
+from floodsph.sph.kernels import seeded_smoothing_length
 
 
 def build_model(scenario: Scenario, inputs):
@@ -28,32 +31,33 @@ def build_model(scenario: Scenario, inputs):
         inputs.particles,
         numerics,
         walls=inputs.walls,
-        closed_edges=_closed_edges(scenario.terrain),
+        closed_sides=_closed_sides(scenario.terrain),
         boundaries=open_boundaries(scenario, inputs, numerics),
         refiner=Refiner.of(numerics),
         held=inputs.depth > 0.0,
     )
 
 
-def _closed_edges(terrain) -> bool | tuple[str, ...]:
-    """``set_up_model(closed_edges=...)``: True, False, or the sides kept closed."""
+def _closed_sides(terrain) -> frozenset[str]:
+    """``set_up_model(closed_sides=...)``: the sides of the DEM kept closed, all four when
+    ``terrain.edges = "closed"``."""
     if terrain.edges is Edges.CLOSED:
-        return True
-    return terrain.closed_sides or False
+        return frozenset(SIDES)
+    return frozenset(terrain.closed_sides)
 
 
-def open_boundaries(scenario: Scenario, inputs, numerics) -> list:
+def open_boundaries(scenario: Scenario, inputs, numerics) -> list[Boundary]:
     """The ``[[inflows]]`` sections (``inputs.inflows``, in the terrain's CRS) and ``[[sinks]]``
     polygons (``inputs.sinks``, inline or from vector files) as model boundaries."""
     terrain = inputs.terrain
     source = scenario.path.name
-    out = []
+    out: list[Boundary] = []
     for i, (inflow, hydrograph) in enumerate(zip(inputs.inflows, inputs.hydrographs,
                                                  strict=True)):
         line = np.column_stack(terrain.to_local(*np.asarray(inflow.line, dtype=np.float64).T))
         out.append(Inflow(line, hydrograph, numerics.particle_spacing_m, numerics.kappa, terrain,
                           direction=inflow.direction, name=f"{source}: inflows[{i}]"))
-    reach = 4.0 * numerics.kappa * numerics.particle_spacing_m
+    reach = 4.0 * seeded_smoothing_length(numerics.kappa, numerics.particle_spacing_m)
     for polygon in inputs.sinks:
         out.append(Sink(polygon, terrain, reach))
     return out

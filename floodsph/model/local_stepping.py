@@ -34,13 +34,16 @@ def big_step(model: FloodModel, dt_max: float | None) -> float:
     n_sub = 2 ** levels
     stride = np.empty(p.n, dtype=np.int64)
     local_steps.strides(p.u, p.v, p.rho, p.h, model.numerics.cfl, dt_f, n_sub, stride)
-    local_steps.limit_strides(stride, model.nl.start, model.nl.nbr, p.n, p.stride)
+    nl = model.nl
+    assert nl is not None  # the lists of the last step, built before the first
+    local_steps.limit_strides(stride, nl.start, nl.nbr, p.n, p.stride)
     zone = np.zeros(p.n, dtype=bool)
     for boundary in model.boundaries:
         zone |= boundary.protected(p.x, p.y)
     p.stride[zone] = 1
     half = 0.5 * dt_f
-    end = np.arange(p.n, dtype=np.int64)  # every particle's step begins at finest step 0
+    # every particle's step begins at finest step 0
+    end: np.ndarray | None = np.arange(p.n, dtype=np.int64)
     for sub in range(n_sub):
         model.lists_fresh = False
         # the steps that end at finest step sub begin anew: no particle has been added or

@@ -66,7 +66,8 @@ class ParticleSet:
 
     def __init__(self, capacity: int = 1024):
         capacity = max(int(capacity), 1)
-        self._data = {name: np.zeros(capacity, dtype=dt) for name, (dt, _) in FIELDS.items()}
+        self._data: dict[str, np.ndarray] = {
+            name: np.zeros(capacity, dtype=dt) for name, (dt, _) in FIELDS.items()}
         self.n = 0
         self.next_pid = 0
 

@@ -2,8 +2,8 @@
 
 A particle's area A_i = m_i / rho_i [m2] grows as its depth d_i = rho_i / rho_w shrinks, so a
 thin flood front is carried by few, huge particles. :class:`Refiner` splits such particles
-into seven daughters (method notes section 4) and coalesces pairs of small ones where the
-water has deepened again (section 5), so that the particle count follows the flow's needs.
+into seven daughters and coalesces pairs of small ones where the water has deepened again
+(``docs/method.md`` §6), so that the particle count follows the flow's needs.
 The numerics live in :mod:`floodsph.sph.refine`; this module selects the particles and does
 the bookkeeping. Total mass and linear momentum are unchanged to round-off by every split
 and every merge.
@@ -25,10 +25,10 @@ below is a ``refine_*`` field of ``floodsph.scenario.numerics.Numerics``: area_m
   unprotected, closer than h_b and without a velocity jump (:meth:`Refiner._absorptions`):
   a lone small particle in deep, fast water otherwise sets the global time step.
 
-New particles (method notes 4.3 and 5): daughters take h = 0.9 h_p, merged particles the h_M
+New particles (``docs/method.md`` §6): daughters take h = 0.9 h_p, merged particles the h_M
 of ``floodsph.sph.refine.merged_h`` (floored at the lattice value kappa sqrt(A_M), see there).
 Both get the reference values h0 = h and rho0 = rho (their smoothing length and density guess
-at creation: for a daughter rho0 = rho_p, h0 = 0.9 h_p, the notes' h0_k = 0.9 h0_p, rho0_k =
+at creation: for a daughter rho0 = rho_p, h0 = 0.9 h_p, Vacondio et al.'s h0_k = 0.9 h0_p, rho0_k =
 rho0_p re-based to the parent's current state), so that the relation h = h0 (rho0 / rho)^(1/2)
 of the density solve holds at creation and h stays consistent with density afterwards.
 After creation, :func:`relax_smoothing` takes each over-smoothed particle to
@@ -187,7 +187,7 @@ class Refiner:
             return idx
         h_parent = _parent_h(p, idx, model.numerics.kappa, s.refine_smoothing_excess)
         x, y, _ = _daughter_positions(p, idx, h_parent)
-        walled = model.closed_edges is not False
+        walled = bool(model.closed_sides)
         ok = model.terrain.covers(x, y, valid_only=not walled)  # walled nodata slivers are wet area
         ok = ok.reshape(-1, refine.DAUGHTERS).all(axis=1)
         wi = model.wall_index
@@ -345,7 +345,7 @@ def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE,
 
     The density solve keeps C_i = h0_i^2 rho0_i = h_i^2 rho_i fixed. A daughter starts with
     C = (0.9 h_p)^2 rho_p, about 5.7 times kappa^2 m_k, and a second split compounds it, so
-    its neighbour count and smoothing grow with every generation (method notes 4.3, caveat).
+    its neighbour count and smoothing grow with every generation (``docs/method.md`` §6).
     Each step, ln C moves by ``rate`` of the way to ln(excess kappa^2 m) where C
     exceeds it; h0 and the current h (the Newton guess) are rescaled alike, so the density
     solve follows in a few iterations and the excess is gone about 10 steps after a split.
@@ -371,7 +371,7 @@ def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE,
 def _daughter_positions(p, idx, h_parent: np.ndarray):
     """Positions [m] and masses [kg] of the seven daughters of each parent ``idx``: a centre and
     a hexagon of radius eps h_parent [m], turned along the parent's velocity
-    (``floodsph.sph.refine.daughters``, method notes 4)."""
+    (``floodsph.sph.refine.daughters``, ``docs/method.md`` §6)."""
     from floodsph.sph import refine
 
     n = refine.DAUGHTERS * idx.size

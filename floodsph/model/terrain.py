@@ -15,7 +15,7 @@
 
 Particles sample these grids bilinearly (``floodsph.sph.bed``). Analytic test beds are built
 through the same type with :meth:`Terrain.from_function`, so tests exercise the real path.
-DEM files are read by ``floodsph.io.dem``, which returns a ``Terrain``.
+DEM files are read by ``floodsph.inputs.dem``, which returns a ``Terrain``.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ class Terrain:
         (``floodsph.io.crs``); None for a geographic DEM or a synthetic bed.
     coordinates_crs_wkt : str or None
         The CRS of the scenario's inline coordinates when ``[scenario] crs`` names one; None:
-        ``source_crs_wkt`` (``floodsph.inputs.coordinates``).
+        ``source_crs_wkt`` (``floodsph.io.coordinates``).
     """
 
     elevation: np.ndarray
@@ -62,7 +62,8 @@ class Terrain:
     x0: float = 0.0
     y0: float = 0.0
     crs_wkt: str | None = None
-    valid: np.ndarray | None = None
+    # None is taken as every cell valid: __post_init__ always leaves the mask here
+    valid: np.ndarray = None  # type: ignore[assignment]
     source_crs_wkt: str | None = None
     source_scale: tuple[float, float] | None = None
     coordinates_crs_wkt: str | None = None
@@ -166,7 +167,7 @@ class Terrain:
             self.curv_xx,
             self.curv_xy,
             self.curv_yy,
-            self.manning,
+            np.asarray(self.manning),  # the grid __post_init__ made of it: no copy
         )
 
 

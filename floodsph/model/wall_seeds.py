@@ -25,6 +25,7 @@ def settle_at_walls(model: FloodModel, rho_seed: np.ndarray) -> float:
     if idx.size == 0:
         return 0.0
     nl = model.nl
+    assert nl is not None  # built by the set-up's first solve
     rows = wall_seeding.neighbourhood(idx, nl.start, nl.nbr, model.particles.n,
                                       wall_seeding.RINGS)
     rounds = _settle(model, idx, rows)
@@ -41,6 +42,7 @@ def wall_seeds(model: FloodModel, rho_seed: np.ndarray) -> np.ndarray:
     ``wall_seeding.ENCLOSURE`` h (``wall_seeding.enclosed_seeds``)."""
     p, nl = model.particles, model.nl
     dx = model.numerics.particle_spacing_m
+    assert nl is not None and dx is not None  # the set-up's first solve; set_up_model's check
     n = p.n
     candidate = np.abs(p.m - rho_seed * dx * dx) <= 1e-9 * p.m
     candidate &= np.diff(model.walls_near.wstart[:n + 1]) > 0
@@ -70,7 +72,9 @@ def _settle(model: FloodModel, idx: np.ndarray, rows: np.ndarray) -> int:
     p = model.particles
     x0, y0 = p.x[idx].copy(), p.y[idx].copy()
     mx, my = np.zeros(p.n), np.zeros(p.n)
-    limit = wall_seeding.MAX_SHIFT * model.numerics.particle_spacing_m
+    spacing = model.numerics.particle_spacing_m
+    assert spacing is not None  # set_up_model refuses a model without it
+    limit = wall_seeding.MAX_SHIFT * spacing
     taken = 0
     while (taken < wall_seeding.SETTLE_STEPS
            and np.hypot(p.ax[idx], p.ay[idx]).max() >= wall_seeding.SETTLED * GRAVITY):

@@ -9,7 +9,8 @@ class maps) and evaluates only the cells the reference map covers. A cell is wet
 depth is above the threshold (class maps: class > 0; the other quantities: where the map
 has a value); NaN/nodata counts as dry.
 With hits = wet in both, false alarms = wet in the model only, misses = wet in the reference
-only (flood-practice.md section 1.6; seamlesswave.com/metrics; Wing et al. 2017 use 0.10 m):
+only (``docs/outputs.md``, ``floodsph compare`` outputs; seamlesswave.com/metrics; Wing et al.
+2017 use 0.10 m):
 
     H   = hits / (hits + misses)                               hit rate
     FAR = false alarms / (hits + false alarms)                 false alarm ratio
@@ -130,7 +131,7 @@ def point_rows(raster: Raster, points) -> list[dict]:
                "error": math.nan, "status": "outside"}
         if 0 <= i < ny and 0 <= j < nx:
             value = float(raster.data[i, j])
-            if raster.quantity.threshold and math.isnan(value):
+            if raster.quantity is not None and raster.quantity.threshold and math.isnan(value):
                 value = 0.0
             row["modelled"] = value
             row["status"] = "compared" if math.isfinite(value) else "no value"
@@ -272,6 +273,7 @@ def write_outputs(result: Comparison, out_dir) -> list:
     out_dir.mkdir(parents=True, exist_ok=True)
     m = result.model
     quantity = m.quantity
+    assert quantity is not None  # compare_maps gave both maps their quantity
     diff_path = write_north_up(out_dir / "difference.tif", result.difference.astype(np.float32),
                                m.crs, m.transform, f"{quantity.name} difference",
                                "1" if quantity.classes else quantity.units,

@@ -19,7 +19,7 @@ import numpy as np
 
 from floodsph.checks.placement import lonlat_hint, user_extent_text
 from floodsph.errors import InputError
-from floodsph.inputs.coordinates import to_model
+from floodsph.io.coordinates import to_model
 from floodsph.io.text import header_found, read_text
 from floodsph.output.grid import bilinear
 
@@ -40,7 +40,7 @@ class GaugePoints:
 
 def read_gauge_file(path, terrain) -> GaugePoints:
     """Read a UTF-8 CSV (a BOM allowed) with columns ``id, x, y`` (world coordinates in the
-    CRS of the inline coordinates, ``floodsph.inputs.coordinates``).
+    CRS of the inline coordinates, ``floodsph.io.coordinates``).
 
     Raises InputError naming the file and line for a file that is not UTF-8, a missing
     column, a non-numeric coordinate, a duplicate id or a point outside the DEM (saying so
@@ -53,7 +53,9 @@ def read_gauge_file(path, terrain) -> GaugePoints:
     if not rows or not {"id", "x", "y"} <= set(rows[0]):
         raise InputError(f"{path}: gauge file needs the columns id, x, y; "
                          f"{header_found(text)}")
-    ids, xs, ys = [], [], []
+    ids: list[str] = []
+    xs: list[float] = []
+    ys: list[float] = []
     for line, row in enumerate(rows, start=2):
         try:
             x, y = float(row["x"]), float(row["y"])
@@ -71,9 +73,9 @@ def read_gauge_file(path, terrain) -> GaugePoints:
         ids.append(row["id"])
         xs.append(lx)
         ys.append(ly)
-    x, y = np.array(xs), np.array(ys)
-    return GaugePoints(tuple(ids), x, y, bilinear(terrain.elevation, terrain.dx, terrain.dy,
-                                                  x, y))
+    gx, gy = np.array(xs), np.array(ys)
+    return GaugePoints(tuple(ids), gx, gy, bilinear(terrain.elevation, terrain.dx, terrain.dy,
+                                                    gx, gy))
 
 
 class Gauges:
@@ -133,7 +135,7 @@ class Gauges:
             w = csv.writer(f)
             w.writerow(HEADER + ((CALENDAR_COLUMN,) if self.start is not None else ()))
             for t, gid, d, lvl, s in self.rows:
-                row = (f"{t:.3f}", gid, f"{d:.4f}", f"{lvl:.4f}", f"{s:.4f}")
+                row: tuple[str, ...] = (f"{t:.3f}", gid, f"{d:.4f}", f"{lvl:.4f}", f"{s:.4f}")
                 if self.start is not None:
                     row += (utc_text(self.start + timedelta(seconds=round(t, 3))),)
                 w.writerow(row)

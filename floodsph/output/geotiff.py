@@ -10,7 +10,7 @@ with ``COPY_SRC_OVERVIEWS`` (the COG layout). Rows are flipped to north-up and t
 is the grid's world transform in the DEM CRS.
 
 Files are written under a temporary name and renamed
-(:func:`floodsph.run.atomic_files.atomic_path`),
+(:func:`floodsph.io.atomic_files.atomic_path`),
 so a file of the final name is complete.
 """
 
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from floodsph.run.atomic_files import atomic_path
+from floodsph.io.atomic_files import atomic_path
 
 BLOCK = 512
 

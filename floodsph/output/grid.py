@@ -41,7 +41,7 @@ class OutputGrid:
     x0: float
     y0: float
     crs_wkt: str | None
-    bed: np.ndarray
+    bed: np.ndarray | None
 
     @classmethod
     def from_terrain(cls, terrain, resolution_m: float | None = None) -> OutputGrid:

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.io.atomic_files import atomic_path
 from floodsph.output.cf import (
     CLASS_DTYPE,
     COORD_ATTRS,
@@ -35,7 +36,6 @@ from floodsph.output.cf import (
     time_attrs,
     variable_attrs,
 )
-from floodsph.run.atomic_files import atomic_path
 
 
 def write_flood_maps(path, maps: dict, info: dict, grid, *, class_names: dict,
@@ -116,6 +116,7 @@ def flood_maps_dataset(maps: dict, info: dict, grid, *, class_names: dict,
         long_name, units, cell_methods = info[name]
         attrs = variable_attrs(name, long_name, units, cell_methods=cell_methods,
                                grid_mapping=crs is not None)
+        data: np.ndarray
         if np.asarray(arr).dtype == np.uint8:
             attrs.update(flag_attrs(class_names[name]))
             data = np.asarray(arr, dtype=np.uint8)[::-1]

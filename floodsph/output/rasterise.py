@@ -117,7 +117,7 @@ def kernel_sums(px, py, x, y, u, v, m, rho, h, level=None) -> np.ndarray:
         grid = CellGrid(gx, gy, 2.0 * float(lv_hmax[lv]), tuple(box[lv]))
         k = np.flatnonzero(_reached(px, py, grid))
         part = np.zeros((k.size, 4), dtype=np.float64)
-        accumulate_sums(px[k], py[k], gx, gy, gh, vol[group], d[group], u[group], v[group],
+        accumulate_sums(px[k], py[k], gx, gy, gh, vol[group], d[group], u[group], v[group],  # type: ignore[call-arg]  # numba
                         *grid.arrays(), part)
         sums[k] += part
     return sums

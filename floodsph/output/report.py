@@ -177,7 +177,7 @@ def gauge_summary(rows) -> list[dict]:
     """Per gauge, in file order: the first wet time (arrival), the peak depth and level and
     the time of the peak depth [s]; None while a gauge never got wet. ``rows`` are
     ``(t, id, depth, level, speed)`` with NaN when dry (gauges.csv)."""
-    out = {}
+    out: dict[str, dict] = {}
     for t, gid, depth, level, _ in rows:
         g = out.setdefault(gid, {"id": gid, "arrival_s": None, "peak_depth_m": None,
                                  "peak_level_m": None, "peak_time_s": None})

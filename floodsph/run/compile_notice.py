@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from typing import Any
 
 START_MESSAGE = "compiling the numerical kernels (first run only; they are cached afterwards)"
 
@@ -26,7 +27,7 @@ class CompileNotice:
         self.kernels = 0
         self._depth = 0
         self._started = 0.0
-        self._listener = None
+        self._listener: Any = None  # numba's event listener while compiling
 
     def __enter__(self) -> CompileNotice:
         from numba.core import event

@@ -15,7 +15,7 @@ Rules (``docs/run-folder.md``, the run-folder contract):
   ``flock`` on POSIX, ``msvcrt.locking`` on Windows); the operating system releases it when
   the process ends, however it ends, so a killed run never leaves a stale lock.
 * Every file goes in under a temporary name and is renamed into place
-  (``floodsph.run.atomic_files``); files are readable by the group, as the user's umask allows.
+  (``floodsph.io.atomic_files``); files are readable by the group, as the user's umask allows.
 """
 
 from __future__ import annotations
@@ -24,43 +24,34 @@ import os
 import shutil
 from collections.abc import Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from floodsph.errors import InputError
-from floodsph.run.atomic_files import TEMP_PREFIX
+from floodsph.io.atomic_files import TEMP_PREFIX
+from floodsph.io.run_names import (
+    BREACH_GLOB,
+    CHECKPOINT_DIR,
+    GAUGES_NAME,
+    LOCK_NAME,
+    LOG_NAME,
+    MAP_NAMES,
+    MASS_BALANCE_NAME,
+    PICTURE_NAMES,
+    REPORT_NAME,
+    RESOLVED_NAME,
+    SERIES_PICTURE_NAMES,
+    SNAPSHOTS_NAME,
+    STAGING_DIR,
+)
 from floodsph.run.manifest import MANIFEST_NAME, read_manifest
 
-LOG_NAME = "floodsph.log"
-RESOLVED_NAME = "scenario.resolved.toml"
-MASS_BALANCE_NAME = "mass_balance.csv"
-GAUGES_NAME = "gauges.csv"
-SNAPSHOTS_NAME = "snapshots.nc"
-CHECKPOINT_DIR = "checkpoint"
-STAGING_DIR = ".floodsph-new"
-LOCK_NAME = ".floodsph.lock"
-MAP_NAMES = (
-    "max_depth.tif",
-    "max_speed.tif",
-    "max_unit_discharge.tif",
-    "max_level.tif",
-    "arrival_time.tif",
-    "time_of_max_depth.tif",
-    "duration.tif",
-    "hazard_uk.tif",
-    "hazard_arr.tif",
-    "flood_maps.nc",
-)
-#: Quick-look PNGs written by ``floodsph.output.write_pictures`` when matplotlib is installed.
-PICTURE_NAMES = ("max_depth.png", "max_speed.png", "max_unit_discharge.png", "duration.png",
-                 "hazard_uk.png", "hazard_arr.png", "arrival_time.png")
-#: Time-series PNGs (``floodsph.output.pictures.write_series_pictures``), with matplotlib.
-SERIES_PICTURE_NAMES = ("gauges.png", "mass_balance.png")
-#: The run's summary page (``floodsph.output.report``).
-REPORT_NAME = "report.html"
-#: Every file name a run writes (scenario-format.md, "Run folder"); a run's files in progress
+if TYPE_CHECKING:
+    from filelock import BaseFileLock
+
+#: Every file name a run writes (``docs/run-folder.md``); a run's files in progress
 #: carry one of these names with a suffix (``snapshots.nc.part``, ``max_depth.tif.part``).
 RUN_FILES = (*MAP_NAMES, SNAPSHOTS_NAME, GAUGES_NAME, MASS_BALANCE_NAME, MANIFEST_NAME,
              RESOLVED_NAME, LOG_NAME, *PICTURE_NAMES, *SERIES_PICTURE_NAMES, REPORT_NAME)
-BREACH_GLOB = "breach_hydrograph_*.csv"
 #: Statuses of a run whose maps are written: its folder is only replaced on request.
 FINISHED = ("completed", "stopped")
 
@@ -95,7 +86,7 @@ class RunFolder:
         self.overwrite = bool(overwrite)
         self.resume = bool(resume)
         self.staged = False
-        self._lock_file = None  # a filelock.FileLock while the folder is held
+        self._lock_file: BaseFileLock | None = None  # held while the run writes the folder
 
     # -- checks (nothing written) ------------------------------------------------------------
     def check(self) -> None:

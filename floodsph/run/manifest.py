@@ -1,9 +1,9 @@
 """The run manifest ``run.json``: what ran, how it ended, and its key numbers.
 
-Keys (contract, ``scenario-format.md``): ``floodsph_version``, ``scenario`` (the resolved
-scenario), ``status`` (``"running"`` while the run is under way, then ``"completed"``,
-``"stopped"`` (``--max-steps`` reached first), ``"interrupted"`` or ``"failed"``),
-``sim_time_s``, ``wall_time_s``, ``steps``,
+Keys (the contract, ``docs/run-folder.md`` and ``docs/outputs.md``): ``floodsph_version``,
+``scenario`` (the resolved scenario), ``status`` (``"running"`` while the run is under way,
+then ``"completed"``, ``"stopped"`` (``--max-steps`` reached first), ``"interrupted"`` or
+``"failed"``), ``sim_time_s``, ``wall_time_s``, ``steps``,
 ``particles_initial``, ``particles_max``, ``particles_final``, ``splits``, ``merges``,
 ``mass_error_rel``, ``threads``; and in addition ``error`` (the message of a failed run),
 ``numba_version``, ``python_version``, ``started``/``finished`` (ISO 8601, UTC),
@@ -12,7 +12,7 @@ scenario), ``status`` (``"running"`` while the run is under way, then ``"complet
 mean, run anyway), ``checkpoint_time_s`` (the latest checkpoint) and ``resumed_from`` (the
 checkpoint times the run was resumed from).
 
-The file is written atomically (``floodsph.run.atomic_files``), so a reader never sees half a
+The file is written atomically (``floodsph.io.atomic_files``), so a reader never sees half a
 manifest.
 """
 
@@ -25,7 +25,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from floodsph._version import __version__
-from floodsph.run.atomic_files import atomic_path
+from floodsph.io.atomic_files import atomic_path
 
 MANIFEST_NAME = "run.json"
 

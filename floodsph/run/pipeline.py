@@ -1,6 +1,6 @@
 """``run_scenario``: one scenario from its TOML to a finished run folder.
 
-The chain (architecture.md 3.2): every test ``floodsph check`` makes, in the one function
+The chain (``docs/developing.md``): every test ``floodsph check`` makes, in the one function
 both call (``floodsph.run.preflight``: the run folder, with nothing that is not a floodsph
 run's and no completed run unless replaced; the inputs -- terrain, particles, hydrographs,
 inflow sides, memory -- all before the run folder is touched) -> the folder is locked and
@@ -12,8 +12,8 @@ mass-balance, progress, recorder and checkpoint callbacks -> maps, gauges and ma
 
 ``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached
 before the end time); ``"interrupted"`` (SIGINT, SIGTERM or SIGHUP:
-``floodsph.simulation.stop_signals``;
-once the time loop runs, a checkpoint is written first and the manifest is returned);
+``floodsph.simulation.stop_signals``; once the time loop runs, a checkpoint is written first
+and the manifest is returned);
 ``"failed"`` (the exception is re-raised, its one-line message is in ``error``). A run that
 replaces a completed one is built in ``.floodsph-new/`` and swapped in when it completes.
 """
@@ -27,9 +27,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from floodsph.errors import InputError
-from floodsph.run.atomic_files import TEMP_PREFIX, atomic_path
-from floodsph.run.atomic_files import umask as _umask
-from floodsph.run.folder import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME, RunFolder
+from floodsph.io.atomic_files import TEMP_PREFIX, atomic_path
+from floodsph.io.atomic_files import umask as _umask
+from floodsph.io.run_names import LOG_NAME, MASS_BALANCE_NAME, RESOLVED_NAME
+from floodsph.run.folder import RunFolder
 from floodsph.run.log_file import attach_log, detach_log
 from floodsph.run.manifest import new_manifest, now_iso, write_manifest
 from floodsph.scenario.config import Scenario
@@ -114,7 +115,7 @@ class RunOptions:
 
 def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
     """The run proper, in the opened folder ``work``; see :func:`run_scenario`."""
-    from floodsph.inputs.coordinates import coordinates_wkt
+    from floodsph.io.coordinates import coordinates_wkt
     from floodsph.io.raster import crs_label
 
     log_handler = attach_log(work / LOG_NAME, append=checkpoint is not None)
@@ -256,7 +257,7 @@ def set_threads(threads: int) -> int:
     """Use ``threads`` numba threads (0 = all); returns the number in use."""
     import numba
 
-    available = numba.config.NUMBA_NUM_THREADS
+    available = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # set at import
     n = available if threads == 0 else min(int(threads), available)
     if threads > available:
         log.warning("%d threads asked for, %d available; using %d", threads, available, n)
@@ -270,7 +271,7 @@ def write_inflow_hydrographs(scenario: Scenario, inputs, out: Path) -> list[str]
     The file ``breach_hydrograph_<i>.csv`` (time_s, discharge_m3s) in the run folder is what
     the run used, so it can be checked or reused as a ``hydrograph`` input.
     """
-    from floodsph.inputs.hydrograph import write_hydrograph_csv
+    from floodsph.io.hydrograph import write_hydrograph_csv
 
     names = []
     for i, (inflow, hydrograph) in enumerate(zip(scenario.inflows, inputs.hydrographs,

@@ -14,11 +14,16 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from floodsph.errors import InputError
 from floodsph.run.folder import RunFolder
 from floodsph.scenario.config import Scenario
 from floodsph.simulation.schedules import time_tolerance
+
+if TYPE_CHECKING:
+    from floodsph.inputs.prepare import Inputs
+    from floodsph.simulation.checkpoint import Checkpoint
 
 log = logging.getLogger(__name__)
 
@@ -29,8 +34,8 @@ class Preflight:
     checkpoint to continue from (else None)."""
 
     folder: RunFolder
-    inputs: object
-    checkpoint: object | None
+    inputs: Inputs
+    checkpoint: Checkpoint | None
 
 
 def preflight(scenario: Scenario, out_dir: str | Path | None = None, *,
@@ -64,6 +69,8 @@ def _resumable(folder: RunFolder, scenario: Scenario, inputs, threads: int | Non
     from floodsph.simulation.checkpoint import load_checkpoint, scenario_difference
 
     directory = folder.checkpoint_dir()
+    if directory is None:
+        raise InputError(f"{folder.path}: no checkpoint to resume from")
     checkpoint = load_checkpoint(directory, inputs.terrain)
     where = scenario_difference(checkpoint.scenario, scenario.to_dict())
     if where is not None:

@@ -1,7 +1,7 @@
 """A finished run folder as Python objects: its manifest and its maps as an xarray Dataset.
 
 :class:`RunResult` is what :func:`floodsph.run_scenario` returns and :func:`open_run` reads
-back from any run folder (scenario-format.md, "Run folder"). Its maps come from
+back from any run folder (``docs/run-folder.md``). Its maps come from
 ``flood_maps.nc`` when the run wrote it, else from the GeoTIFFs; either way it is the same
 Dataset, that of ``flood_maps.nc`` (class maps as uint8): one variable per map
 (``max_depth`` [m], ``max_speed`` [m/s], ..., ``hazard_uk``), cell-centre coordinates ``x``
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from floodsph.errors import InputError
-from floodsph.run.folder import MAP_NAMES
+from floodsph.io.run_names import MAP_NAMES
 from floodsph.run.manifest import MANIFEST_NAME, read_manifest
 
 NETCDF_MAPS = "flood_maps.nc"

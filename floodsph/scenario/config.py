@@ -17,7 +17,7 @@ from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from floodsph.checks.roughness import N_DEFAULT
+from floodsph.io.roughness import N_DEFAULT
 from floodsph.scenario.numerics import Numerics
 
 if TYPE_CHECKING:
@@ -46,7 +46,7 @@ class ScenarioInfo:
     the calendar instant of its start (time zone aware, None when the scenario gives none;
     hydrograph dates count from it). ``crs`` is the CRS of the inline coordinates (polygons,
     lines, extents) when they are not in the DEM file's own CRS
-    (``floodsph.inputs.coordinates``)."""
+    (``floodsph.io.coordinates``)."""
 
     name: str
     end_time_s: float
@@ -114,7 +114,7 @@ class Wall:
 
     @property
     def closed(self) -> bool:
-        return self.polyline[0] == self.polyline[-1]
+        return self.polyline is not None and self.polyline[0] == self.polyline[-1]
 
 
 @dataclass(frozen=True)
@@ -122,8 +122,7 @@ class Inflow:
     """``[[inflows]]``: a breach section with a discharge hydrograph Q(t) [m3/s].
 
     ``hydrograph`` is the CSV of Q(t) (read by ``floodsph.inputs.prepare``, as every file the
-    scenario
-    names); ``breach`` the validated ``[inflows.breach]`` table of a parametric breach
+    scenario names); ``breach`` the validated ``[inflows.breach]`` table of a parametric breach
     (``floodsph.breach.params.BreachParams``, file paths absolute), routed into Q(t) there.
 
     ``direction`` (optional) is the flow direction [dx, dy]; by default water enters normal
@@ -223,7 +222,9 @@ class Scenario:
                  t.manning_table if isinstance(t.manning_table, Path) else None,
                  t.manning if isinstance(t.manning, Path) else None,
                  *(w.depth for w in self.initial_water),
-                 *(entry.file for entry in (*self.initial_water, *self.walls, *self.sinks)),
+                 *(entry.file for entry in self.initial_water),
+                 *(entry.file for entry in self.walls),
+                 *(entry.file for entry in self.sinks),
                  *(i.hydrograph for i in self.inflows),
                  None if self.gauges is None else self.gauges.file]
         return tuple(f for f in files if f is not None)

@@ -1,12 +1,12 @@
 """``Numerics``: every setting of the solver, the scenario's ``[numerics]`` table as it is.
 
-A field of :class:`Numerics` is named as its key in the scenario file (``scenario-format.md``):
-``particle_spacing_m`` in the TOML is ``numerics.particle_spacing_m`` in the model. Its default
-and its bounds are written here once; ``floodsph.scenario.config`` reads the table straight into it,
-``floodsph.model.flood_model.FloodModel`` and ``floodsph.model.refinement.Refiner`` read it. A few
-fields are
-not scenario keys (``metadata["scenario"]`` False): the solver's inner tunables, set by tests
-and studies only; they are neither read from nor written to scenario files.
+A field of :class:`Numerics` is named as its key in the scenario file
+(``docs/scenario-reference.md``, ``[numerics]``): ``particle_spacing_m`` in the TOML is
+``numerics.particle_spacing_m`` in the model. Its default and its bounds are written here once;
+``floodsph.scenario.reader`` reads the table straight into it, and
+``floodsph.model.flood_model.FloodModel`` and ``floodsph.model.refinement.Refiner`` read it. A
+few fields are not scenario keys (``metadata["scenario"]`` False): the solver's inner tunables,
+set by tests and studies only; they are neither read from nor written to scenario files.
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ class Momentum(Enum):
 
 class WallModel(Enum):
     """How walls hold water: mirror images (``floodsph.walls.images``), or the experimental
-    boundary integral (``floodsph.walls.shadow``; measured in ``docs/still-water.md``)."""
+    boundary integral (``floodsph.sph.shadow``; measured in ``docs/still-water.md``)."""
 
     MIRROR = "mirror"
     INTEGRAL = "integral"
@@ -102,7 +102,7 @@ class Numerics:
     cfl : Courant number of dt = cfl min h / (|v| + c).
     refinement : splitting and coalescing of particles (``floodsph.model.refinement``).
     threads : numba threads of a run; 0 means all cores.
-    kappa : h0 / particle spacing. 1.2 (SWE-SPHysics' suggested value, method notes 1.4): on
+    kappa : h0 / particle spacing. 1.2 (SWE-SPHysics' suggested value, ``docs/method.md`` §2): on
         the square lattice the water is seeded on, still water is then a minimum of the SPH
         energy and stays still; at 1.3, 1.25, 1.15 or 1.4-2 the lattice is a saddle of it and
         a still lake stirs itself up within minutes (``workflows/lattice_stability.py``).
@@ -121,7 +121,7 @@ class Numerics:
         particles.
     step_levels : K of local stepping: a big step holds up to 2^K finest steps.
     wall_model : "mirror" (mirror images, the default) or "integral" (the experimental
-        boundary integral of ``floodsph.walls.shadow``).
+        boundary integral of ``floodsph.sph.shadow``).
     momentum : "variational" (the default) or "balanced": -g grad eta as renormalised
         differences of the free-surface level eta, a lake at rest an exact equilibrium
         (``floodsph.sph.level_momentum``); with the "lax-friedrichs" stabilisation and

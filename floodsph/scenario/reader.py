@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from floodsph.checks.elevation import ELEVATION_LIMIT_M
-from floodsph.checks.roughness import N_STRICKLER, strickler_text
+from floodsph.io.roughness import N_DEFAULT, N_STRICKLER, strickler_text
 from floodsph.scenario.config import (
     SIDES,
     TOP_KEYS,
@@ -139,7 +139,7 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
     if isinstance(manning, str):
         manning = r.file_value(manning, join(p, "manning"))
     else:
-        manning = r.number(t, p, "manning", TerrainConfig.manning, gt=0.0)
+        manning = r.number(t, p, "manning", N_DEFAULT, gt=0.0)
         if manning >= N_STRICKLER:
             raise r.fail(join(p, "manning"), strickler_text(manning))
     landcover = r.existing_file(t, p, "landcover", None)
@@ -154,8 +154,10 @@ def _terrain(r: Reader, data: dict) -> TerrainConfig:
         where = join(p, "extent")
         if not isinstance(ext, list) or len(ext) != 4:
             raise r.fail(where, "expected [xmin, ymin, xmax, ymax]")
-        extent = tuple(r.number({"v": v}, join(where, k), "v") for k, v in enumerate(ext))
-        if not (extent[0] < extent[2] and extent[1] < extent[3]):
+        xmin, ymin, xmax, ymax = (r.number({"v": v}, join(where, k), "v")
+                                  for k, v in enumerate(ext))
+        extent = (xmin, ymin, xmax, ymax)
+        if not (xmin < xmax and ymin < ymax):
             raise r.fail(where, f"expected xmin < xmax and ymin < ymax, got {list(extent)}")
     if landcover is not None:
         manning = None
@@ -260,8 +262,9 @@ def _wall(r: Reader, t: dict, p: str) -> Wall:
 
 def _inflow(r: Reader, t: dict, p: str) -> Inflow:
     r.check_keys(t, p, ("line", "hydrograph", "breach", "direction"))
-    line = r.points(t, p, "line", at_least=2, exactly=2)
-    if line[0] == line[1]:
+    a, b = r.points(t, p, "line", at_least=2, exactly=2)
+    line = (a, b)
+    if a == b:
         raise r.fail(join(p, "line"), "the two end points are the same")
     if ("hydrograph" in t) == ("breach" in t):
         raise r.fail(p, "expected exactly one of hydrograph (a CSV file) or [breach]")
@@ -324,8 +327,7 @@ def _gauges(r: Reader, data: dict) -> Gauges | None:
 
 def _numerics(r: Reader, data: dict) -> Numerics:
     """``[numerics]`` straight into :class:`~floodsph.scenario.numerics.Numerics`: each key read as
-    the
-    type of its field, then checked by ``Numerics`` itself (bounds, the refinement rule)."""
+    the type of its field, then checked by ``Numerics`` itself (bounds, the refinement rule)."""
     p = "numerics"
     t = r.sub_table(data, "", p, NUMERICS_KEYS)
     values = {}

@@ -16,19 +16,16 @@ import tomllib
 from datetime import datetime
 from enum import Enum
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar, overload
 
 from floodsph.checks.shapes import polygon_problem, polyline_problem
+from floodsph.constants import LARGEST_VALUE
 from floodsph.errors import InputError
 
 #: Marks a key without a default: absent means "missing required key".
-REQUIRED = object()
+REQUIRED: Any = object()
 
-LARGEST_VALUE = 1.0e12
-"""The largest magnitude any number of a scenario may have. No quantity of a flood scenario in
-SI units comes near it (projected coordinates stay below 1e8 m, the largest reservoirs hold
-2e11 m3, 1e12 s is 30,000 years), while a value beyond it (1e308) overflows to infinity in
-the first product it enters."""
+E = TypeVar("E", bound=Enum)
 
 
 def read_toml(path: Path, what: str) -> dict:
@@ -129,6 +126,18 @@ class Reader:
         return table[key]
 
     # -- scalars --------------------------------------------------------------------------
+    # A read with ``default=None`` may give None; a required one, or one with a number as its
+    # default, gives a number.
+    @overload
+    def number(self, table: dict, path: str, key: str, default: None, *,
+               gt: float | None = None, ge: float | None = None,
+               le: float | None = None) -> float | None: ...
+
+    @overload
+    def number(self, table: dict, path: str, key: str, default: float = ..., *,
+               gt: float | None = None, ge: float | None = None,
+               le: float | None = None) -> float: ...
+
     def number(
         self,
         table: dict,
@@ -178,6 +187,12 @@ class Reader:
             raise self.fail(where, f"must be <= {le}, got {value}")
         return value
 
+    @overload
+    def string(self, table: dict, path: str, key: str, default: None) -> str | None: ...
+
+    @overload
+    def string(self, table: dict, path: str, key: str, default: str = ...) -> str: ...
+
     def string(self, table: dict, path: str, key: str, default: Any = REQUIRED) -> str | None:
         value = self._get(table, path, key, default)
         if value is default and key not in table:
@@ -210,12 +225,12 @@ class Reader:
                                    f"{value.isoformat()}+01:00")
         return value
 
-    def choice(self, table: dict, path: str, key: str, enum: type[Enum], default: Enum) -> Enum:
+    def choice(self, table: dict, path: str, key: str, enum: type[E], default: E) -> E:
         """One of the values of ``enum`` (given as its string value)."""
         value = self.string(table, path, key, default.value)
         return self.as_choice(value, join(path, key), enum)
 
-    def as_choice(self, value: Any, path: str, enum: type[Enum]) -> Enum:
+    def as_choice(self, value: Any, path: str, enum: type[E]) -> E:
         allowed = [member.value for member in enum]
         if not isinstance(value, str) or value not in allowed:
             raise self.fail(

@@ -1,6 +1,6 @@
 """Checkpoints: the whole state of a run, saved so that it can continue as if never stopped.
 
-A checkpoint (scenario-format.md, "Checkpoints and resuming a run") holds:
+A checkpoint (``docs/run-folder.md``, "Checkpoints and ``--resume``") holds:
 
 * the model: particles, neighbour and wall lists, boundary and inflow state, refinement
   state, the clock and the counters (the terrain is not stored: it is read again from the
@@ -27,11 +27,12 @@ import os
 import pickle
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from floodsph._version import __version__
 from floodsph.errors import InputError
-from floodsph.run.atomic_files import atomic_path
-from floodsph.run.folder import CHECKPOINT_DIR
+from floodsph.io.atomic_files import atomic_path
+from floodsph.io.run_names import CHECKPOINT_DIR
 
 STATE_NAME = "state.pkl"
 FORMAT = 4
@@ -52,7 +53,7 @@ class Checkpoint:
 
     scenario: dict
     threads: int
-    model: object
+    model: Any
     simulation: dict
     recorders: dict
     mass_rows: list

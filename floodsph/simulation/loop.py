@@ -8,13 +8,11 @@ called with the simulation as their only argument.
 Every callback runs once at the start (the initial state), whenever its schedule is due after
 a step, and once at the end (the final state) unless it already ran on the last step. The
 step is shortened so that the model lands exactly on the end time and on every
-:class:`~floodsph.simulation.schedules.TimeInterval` time. After every step a guard checks that
-depth,
-velocity and position are finite and depth is not negative.
+:class:`~floodsph.simulation.schedules.TimeInterval` time. After every step a guard checks
+that depth, velocity and position are finite and depth is not negative.
 
 A stop request (``should_stop``, e.g. a SIGTERM caught by ``floodsph.simulation.stop_signals``)
-ends the
-loop after the step and its callbacks, without the final calls: :meth:`Simulation.state` is
+ends the loop after the step and its callbacks, without the final calls: :meth:`Simulation.state` is
 then exactly what a run that was never stopped had at that step, and a simulation given that
 state by :meth:`Simulation.restore` continues as that run would (checkpoint and resume).
 """
@@ -24,6 +22,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -60,7 +59,7 @@ class Simulation:
         self,
         model,
         end_time: float,
-        callbacks: Sequence[tuple[Callable, object]] = (),
+        callbacks: Sequence[tuple[Callable, Any]] = (),
         max_steps: int | None = None,
         should_stop: Callable[[], bool] | None = None,
     ):

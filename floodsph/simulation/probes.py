@@ -36,7 +36,7 @@ class MassBalance:
         error = V_domain(t) - (V0 + V_in(t) - V_out(t))      [m3]
         error_rel = |error| / max(V0 + V_in(t), TINY_VOLUME_M3)
 
-    (flood-practice.md 1.5; LISFLOOD-FP's ``.mass`` file). The rows are kept (they go into
+    (as LISFLOOD-FP's ``.mass`` file; ``docs/outputs.md``). The rows are kept (they go into
     checkpoints) and written by :meth:`write` when the run ends.
     """
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from floodsph.run.folder import GAUGES_NAME, SNAPSHOTS_NAME
+from floodsph.io.run_names import GAUGES_NAME, SNAPSHOTS_NAME
 from floodsph.scenario.config import Scenario
 from floodsph.simulation.schedules import TimeInterval
 
@@ -143,9 +143,9 @@ class Recorders:
     def write_report(self, manifest: dict, mass_rows, features) -> str:
         """Write ``report.html`` (:mod:`floodsph.output.report`) beside the quick-looks
         listed in ``manifest["pictures"]``; its name, with a note when it has no pictures."""
+        from floodsph.io.atomic_files import atomic_path
+        from floodsph.io.run_names import REPORT_NAME
         from floodsph.output.report import write_report
-        from floodsph.run.atomic_files import atomic_path
-        from floodsph.run.folder import REPORT_NAME
 
         drawn = not isinstance(manifest.get("pictures"), str)
         with atomic_path(self.out / REPORT_NAME) as tmp:

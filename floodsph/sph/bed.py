@@ -5,8 +5,8 @@ see ``floodsph.model.terrain``). Bilinear interpolation reproduces any field tha
 y within a cell, so the gradient of a paraboloid (linear) and its Hessian (constant) are
 sampled exactly; points beyond the outermost nodes take the value on the border (clamped).
 
-Reference: the bed representation is the cheaper alternative the method notes allow to the
-SPH bed particles of Vacondio et al. (2013) (sph-swe-method.md section 2.4): gradient and
+Reference: the bed representation is the cheaper alternative to the
+SPH bed particles of Vacondio et al. (2013) (``docs/method.md`` §3.5): gradient and
 Hessian precomputed once on the static DEM and interpolated to the particles each step.
 """
 

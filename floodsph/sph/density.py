@@ -1,7 +1,7 @@
 """Depth from SPH density: the Newton-Raphson solve of density and smoothing length.
 
 Equations (Vacondio et al., Adv. Water Resour. 58 (2013) 10-23; Rodriguez-Paz & Bonet,
-Comput. Struct. 83 (2005) 1396-1410; method notes sections 1.4-1.5):
+Comput. Struct. 83 (2005) 1396-1410; ``docs/method.md`` §2):
 
     rho_i = sum_j m_j W(r_ij, h_i)                     (1)  gather summation, self included
     h_i   = h0_i (rho0_i / rho_i)^(1/2)                (2)  d_m = 2
@@ -37,8 +37,8 @@ import numpy as np
 from numba import njit, prange
 
 from floodsph.sph.kernels import w_cubic, w_dwdr_cubic
+from floodsph.sph.shadow import shadow
 from floodsph.walls.images import corner_image, wall_image
-from floodsph.walls.shadow import shadow
 from floodsph.walls.sight import SIGHT_SLACK
 
 H_SHRINK_MIN = 0.8
@@ -59,7 +59,7 @@ def _pair(rx, ry, mj, hi):
 def _image(i, j, x, y, m, hi, seg, s):
     """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's mirror image across segment s
     (x_j' = 2 f_j - x_j, ``floodsph.walls.images.wall_image``) seen from i; (0, 0) when the wall
-    does not hide that image's point from i (MVBP mirror particles, method notes 3.1)."""
+    does not hide that image's point from i (MVBP mirror particles, ``docs/method.md`` §7)."""
     xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
     if not ok:
         return 0.0, 0.0
@@ -70,7 +70,7 @@ def _image(i, j, x, y, m, hi, seg, s):
 def _corner(i, j, x, y, m, hi, seg, s1, s2):
     """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's point reflection through the
     right-angled corner of segments s1 and s2 (``floodsph.walls.images.corner_image``) seen from
-    i; (0, 0) when that image does not apply (method notes 3.1)."""
+    i; (0, 0) when that image does not apply (``docs/method.md`` §7)."""
     xc, yc, ok = corner_image(x[j], y[j], seg, s1, s2)
     if not ok:
         return 0.0, 0.0
@@ -143,7 +143,7 @@ def summation(i, hi, x, y, m, nstart, nbr, blocked, walls):
 
 
 GAMMA_MIN = 0.25
-"""Least water fraction gamma = 1 - S of a support (``floodsph.walls.shadow``) that the
+"""Least water fraction gamma = 1 - S of a support (``floodsph.sph.shadow``) that the
 depth is corrected by: a particle pressed into a corner (gamma 0.25 at the vertex of a right
 angle) is not made deeper still."""
 
@@ -151,7 +151,7 @@ angle) is not made deeper still."""
 @njit(inline="always", cache=True)
 def wall_corrected(i, hi, rsum, alpha, x, y, wstart, wseg, seg):
     """The summation (1) and alpha_i of particle i divided by the water fraction of its support,
-    gamma_i = 1 - S_i(h_i) (``floodsph.walls.shadow.shadow``, at least ``GAMMA_MIN``):
+    gamma_i = 1 - S_i(h_i) (``floodsph.sph.shadow.shadow``, at least ``GAMMA_MIN``):
     rho_i = sum_j m_j W(r_ij, h_i) / gamma_i, the depth of water that fills the support up to the
     walls (Ferrand et al., IJNMF 71 (2013) 446-472, eq. 13). alpha_i is divided alike; the
     derivative of gamma in h is left out of it (the Newton update (3) then converges linearly

@@ -1,17 +1,17 @@
 """Accelerations: the variational pressure force with shock capturing, and the bed.
 
 Internal (pressure) acceleration with the grad-h correction (Vacondio et al. 2013 via
-Rodriguez-Paz & Bonet 2005; method notes eq. (4)), with beta_i = 2 rho_i / alpha_i:
+Rodriguez-Paz & Bonet 2005; ``docs/method.md`` §3.1), with beta_i = 2 rho_i / alpha_i:
 
     a_i^int = - sum_j m_j [ (g beta_i / (2 rho_w) + Pi_ij / 2) grad_i W(r_ij, h_i)
                           + (g beta_j / (2 rho_w) + Pi_ij / 2) grad_i W(r_ij, h_j) ]
 
-Shock capturing (parameter-free, Ata & Soulaimani, IJNMF 47 (2005) 139-159; method notes
-2.2 B), active for approaching pairs (v_ij . x_ij < 0):
+Shock capturing (parameter-free, Ata & Soulaimani, IJNMF 47 (2005) 139-159; ``docs/method.md``
+§3.2), active for approaching pairs (v_ij . x_ij < 0):
 
     Pi_ij = - cbar_ij (v_ij . x_ij) / (rhobar_ij sqrt(r_ij^2 + eta^2)),  eta^2 = 0.01 hbar^2
 
-Option "riemann" (method notes 2.2 C, SWE-SPHysics): g rho_i^2 / (2 rho_w) in the pressure
+Option "riemann" (``docs/method.md`` §3.2, SWE-SPHysics): g rho_i^2 / (2 rho_w) in the pressure
 term of both particles is replaced by the two-shock Riemann pressure p* = g rho_w d*^2 / 2
 (Toro) of the pair, solved along the pair axis.
 
@@ -41,7 +41,7 @@ the real neighbours do not (it sped up the thin front of a dam break in a 100 m 
 The same loop returns the velocity divergence used for the continuity-based density guess,
 div v_i = -(2 / alpha_i) sum_j m_j (v_i - v_j) . grad_i W(r_ij, h_i).
 
-Bed (pointwise, method notes eq. (5)):
+Bed (pointwise, ``docs/method.md`` §3.5):
 
     a_i = a_i^int - [(g + v.K.v + a_i^int . grad b) / (1 + |grad b|^2)] grad b
 
@@ -69,6 +69,15 @@ LAX_FRIEDRICHS = 0
 RIEMANN = 1
 MUSCL = 2
 
+BETA, WAVE_SPEED, INV_H, HALF_G_AREA, K_XX, K_XY, K_YY, G_XX, G_XY, G_YX, G_YY = range(11)
+"""Columns of the per-particle pair coefficients (:func:`pair_coefficients`): beta_i, c_i,
+1 / h_i, g A_i / 2, the pressure renormalisation K_i (xx, xy, yy) and, under "muscl" only, the
+velocity gradient G_i (du/dx, du/dy, dv/dx, dv/dy)."""
+COEF_COLUMNS = 7
+"""Columns of the pair coefficients under "lax-friedrichs" and "riemann"."""
+COEF_COLUMNS_MUSCL = 11
+"""Columns of the pair coefficients under "muscl" (with the velocity gradient)."""
+
 
 @njit(inline="always", cache=True)
 def riemann_pressure(d_l, d_r, u_l, u_r):
@@ -91,30 +100,32 @@ def riemann_pressure(d_l, d_r, u_l, u_r):
 
 @njit(parallel=True, cache=True)
 def pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, dudx, dudy, dvdx, dvdy, coef):
-    """Per-particle factors of the pair force: coef[i] = (beta_i, c_i, 1 / h_i, g A_i / 2,
-    K_i xx, xy, yy, G_i xx, xy, yx, yy).
+    """Per-particle factors of the pair force, the named columns of ``coef[i]``: ``BETA``,
+    ``WAVE_SPEED``, ``INV_H``, ``HALF_G_AREA``, ``K_XX``, ``K_XY``, ``K_YY`` and ``G_XX``,
+    ``G_XY``, ``G_YX``, ``G_YY``.
 
     beta_i = 2 rho_i / alpha_i [-], c_i = sqrt(g rho_i / rho_w) [m s-1] (wave speed),
     1 / h_i [m^-1], g A_i / 2 [m3 s-2] with the area A_i = m_i / rho_i, and the pressure
     renormalisation K_i [-] of ``floodsph.sph.consistency``, and the velocity gradient
     G_i = (du/dx, du/dy; dv/dx, dv/dy) [s-1] of the last force evaluation (only when ``coef``
-    has its 11 columns: the "muscl" stabilisation's; the others take 7). A particle with no
+    has its ``COEF_COLUMNS_MUSCL`` columns: the "muscl" stabilisation's; the others take
+    ``COEF_COLUMNS``). A particle with no
     neighbour within its support (alpha_i = 0, possible when its h is held back by its lists)
     takes beta_i = 1, the uncorrected force (alpha_i = 2 rho_i on a lattice).
     """
     for i in prange(rho.shape[0]):
-        coef[i, 0] = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
-        coef[i, 1] = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
-        coef[i, 2] = 1.0 / h[i]
-        coef[i, 3] = 0.5 * GRAVITY * m[i] / rho[i]
-        coef[i, 4] = kxx[i]
-        coef[i, 5] = kxy[i]
-        coef[i, 6] = kyy[i]
-        if coef.shape[1] > 7:
-            coef[i, 7] = dudx[i]
-            coef[i, 8] = dudy[i]
-            coef[i, 9] = dvdx[i]
-            coef[i, 10] = dvdy[i]
+        coef[i, BETA] = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
+        coef[i, WAVE_SPEED] = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
+        coef[i, INV_H] = 1.0 / h[i]
+        coef[i, HALF_G_AREA] = 0.5 * GRAVITY * m[i] / rho[i]
+        coef[i, K_XX] = kxx[i]
+        coef[i, K_XY] = kxy[i]
+        coef[i, K_YY] = kyy[i]
+        if coef.shape[1] > COEF_COLUMNS:
+            coef[i, G_XX] = dudx[i]
+            coef[i, G_XY] = dudy[i]
+            coef[i, G_YX] = dvdx[i]
+            coef[i, G_YY] = dvdy[i]
 
 
 @njit(inline="always", cache=True)
@@ -141,37 +152,37 @@ def pair_force(rx, ry, vx, vy, i, j, m, rho, h, coef, scheme, kj, gj, image=Fals
     r = math.sqrt(r2)
     inv_r = 1.0 / r
     if image:
-        fi = dwdr_over_r_floored(r, inv_r, coef[i, 2])
-        fj = dwdr_over_r_floored(r, inv_r, coef[j, 2])
+        fi = dwdr_over_r_floored(r, inv_r, coef[i, INV_H])
+        fj = dwdr_over_r_floored(r, inv_r, coef[j, INV_H])
     else:
-        fi = dwdr_over_r_cubic(r, inv_r, coef[i, 2])
-        fj = dwdr_over_r_cubic(r, inv_r, coef[j, 2])
+        fi = dwdr_over_r_cubic(r, inv_r, coef[i, INV_H])
+        fj = dwdr_over_r_cubic(r, inv_r, coef[j, INV_H])
     vr = vx * rx + vy * ry
     if scheme == RIEMANN:
         # axis from i to j: u_l = v_i . e, u_r = v_j . e, so u_l - u_r = -vr / r
         p_star = riemann_pressure(rho[i] / RHO_WATER, rho[j] / RHO_WATER, 0.0, vr * inv_r)
-        fp = m[j] * p_star * (coef[i, 0] * fi / (rho[i] * rho[i])
-                              + coef[j, 0] * fj / (rho[j] * rho[j]))
+        fp = m[j] * p_star * (coef[i, BETA] * fi / (rho[i] * rho[i])
+                              + coef[j, BETA] * fj / (rho[j] * rho[j]))
         fv = 0.0
     else:
         # Pi_ij for approaching pairs, computed for all and zero otherwise (no jump); with
         # "muscl" for every pair, from the limited jump at the midpoint
         hbar = 0.5 * (h[i] + h[j])
-        cbar = 0.5 * (coef[i, 1] + coef[j, 1])
+        cbar = 0.5 * (coef[i, WAVE_SPEED] + coef[j, WAVE_SPEED])
         if scheme == MUSCL:
-            jump = reconstructed_jump(rx, ry, vr, coef[i, 7], coef[i, 8], coef[i, 9],
-                                      coef[i, 10], gj)
+            jump = reconstructed_jump(rx, ry, vr, coef[i, G_XX], coef[i, G_XY], coef[i, G_YX],
+                                      coef[i, G_YY], gj)
         else:
             jump = min(vr, 0.0)
         pi_ij = -cbar * jump / (0.5 * (rho[i] + rho[j])
                                         * math.sqrt(r2 + 0.01 * hbar * hbar))
-        fp = m[j] * (0.5 * GRAVITY / RHO_WATER) * (coef[i, 0] * fi + coef[j, 0] * fj)
+        fp = m[j] * (0.5 * GRAVITY / RHO_WATER) * (coef[i, BETA] * fi + coef[j, BETA] * fj)
         fv = m[j] * 0.5 * pi_ij * (fi + fj)
-    kxx = 0.5 * fp * (coef[i, 4] + kj[0])
-    kxy = 0.5 * fp * (coef[i, 5] + kj[1])
-    kyy = 0.5 * fp * (coef[i, 6] + kj[2])
+    kxx = 0.5 * fp * (coef[i, K_XX] + kj[0])
+    kxy = 0.5 * fp * (coef[i, K_XY] + kj[1])
+    kyy = 0.5 * fp * (coef[i, K_YY] + kj[2])
     f = fp + fv
-    w = coef[j, 3] * (coef[i, 0] * fi + coef[j, 0] * fj)
+    w = coef[j, HALF_G_AREA] * (coef[i, BETA] * fi + coef[j, BETA] * fj)
     return (rx, ry, f * rx + kxx * rx + kxy * ry, f * ry + kxy * rx + kyy * ry, w,
             m[j] * fi * vr, m[j] / rho[j] * fi)
 
@@ -181,7 +192,7 @@ def _gradient(coef, j, scheme):
     """j's velocity gradient (xx, xy, yx, yy) [s-1] from ``coef`` under "muscl"; zeros for the
     other schemes, whose ``coef`` has no such columns."""
     if scheme == MUSCL:
-        return (coef[j, 7], coef[j, 8], coef[j, 9], coef[j, 10])
+        return (coef[j, G_XX], coef[j, G_XY], coef[j, G_YX], coef[j, G_YY])
     return (0.0, 0.0, 0.0, 0.0)
 
 
@@ -234,7 +245,7 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, dud
     dvdx, dvdy) of ``floodsph.sph.velocity_gradient``, current for the particles ``rows``.
     """
     seg, wdist, wstart, wseg, cstart, cpair = walls
-    coef = np.empty((x.shape[0], 11 if scheme == MUSCL else 7))
+    coef = np.empty((x.shape[0], COEF_COLUMNS_MUSCL if scheme == MUSCL else COEF_COLUMNS))
     pair_coefficients(m, rho, alpha, h, kxx, kxy, kyy, dudx, dudy, dvdx, dvdy, coef)
     for k in prange(rows.shape[0]):
         i = rows[k]
@@ -251,9 +262,9 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, dud
             hm = 2.0 * max(hi, h[j])
             if rx * rx + ry * ry >= hm * hm or blocked[q]:
                 continue
+            kj = (coef[j, K_XX], coef[j, K_XY], coef[j, K_YY])
             acc = _subtract(acc, i, j, rho, pair_force(rx, ry, u[i] - u[j], v[i] - v[j], i, j, m,
-                                                       rho, h, coef, scheme,
-                                                       (coef[j, 4], coef[j, 5], coef[j, 6]),
+                                                       rho, h, coef, scheme, kj,
                                                        _gradient(coef, j, scheme)))
         # each near segment's single images, then the corners it opens, in list order; one
         # call site, so that the image terms are compiled once into this kernel
@@ -284,7 +295,7 @@ def internal_acceleration(rows, x, y, u, v, m, rho, alpha, h, kxx, kxy, kyy, dud
             sums[i, D_X + c] = acc[2 + c]
         sums[i, MOMENT_X] = acc[10]
         sums[i, MOMENT_Y] = acc[11]
-        divv[i] = coef[i, 0] * acc[9] / rho[i]  # (2 / alpha_i) fd, with beta's fallback
+        divv[i] = coef[i, BETA] * acc[9] / rho[i]  # (2 / alpha_i) fd, with beta's fallback
 
 
 @njit(inline="always", cache=True)
@@ -342,7 +353,7 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
 @njit(inline="always", cache=True)
 def _image_state(i, j, x, y, u, v, coef, seg, s, s2):
     """(applies, x', y', u', v', K') of j's image as seen from i (MVBP mirror particles,
-    method notes 3.1).
+    ``docs/method.md`` §7).
 
     About segment s (s2 < 0): position x_j' = 2 f_j - x_j (f_j the foot of j on the wall),
     free-slip velocity v_j' = v_j - 2 (v_j . n) n and renormalisation tensor R K_j R,
@@ -357,7 +368,7 @@ def _image_state(i, j, x, y, u, v, coef, seg, s, s2):
         vn = u[j] * nx + v[j] * ny
         um = u[j] - 2.0 * vn * nx
         vm = v[j] - 2.0 * vn * ny
-        kj = _reflect(coef[j, 4], coef[j, 5], coef[j, 6], nx, ny)
+        kj = _reflect(coef[j, K_XX], coef[j, K_XY], coef[j, K_YY], nx, ny)
         return ok, xm, ym, um, vm, kj
     xm, ym, ok = corner_image(x[j], y[j], seg, s, s2)
     _, _, _, n1x, n1y = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
@@ -368,7 +379,7 @@ def _image_state(i, j, x, y, u, v, coef, seg, s, s2):
     vn = um * n2x + vm * n2y
     um -= 2.0 * vn * n2x
     vm -= 2.0 * vn * n2y
-    kxx, kxy, kyy = _reflect(coef[j, 4], coef[j, 5], coef[j, 6], n1x, n1y)
+    kxx, kxy, kyy = _reflect(coef[j, K_XX], coef[j, K_XY], coef[j, K_YY], n1x, n1y)
     kj = _reflect(kxx, kxy, kyy, n2x, n2y)
     return ok, xm, ym, um, vm, kj
 

@@ -17,7 +17,7 @@ For the pressure force, (dW/dr) / r is evaluated from r, 1/r and 1/h without div
 Units: W [m^-2], dW/dr [m^-3], (dW/dr) / r [m^-4]. Support radius 2h.
 
 Reference: Monaghan & Lattanzio (1985); the 2-D normalisation 10/(7 pi h^2) as used by
-Vacondio et al., Adv. Water Resour. 58 (2013) 10-23 (method notes, section 1.3).
+Vacondio et al., Adv. Water Resour. 58 (2013) 10-23 (``docs/method.md`` §2).
 """
 
 from __future__ import annotations
@@ -28,6 +28,14 @@ from numba import njit
 
 SIGMA_2D = 10.0 / (7.0 * math.pi)
 """Normalisation constant of the 2-D cubic spline, W(0, h) = SIGMA_2D / h^2."""
+
+
+def seeded_smoothing_length(kappa, spacing):
+    """h0 = kappa dx [m]: the smoothing length of particles seeded at ``spacing`` dx [m]
+    (``numerics.kappa``, ``docs/method.md`` §2). The one place it is computed: the seeding,
+    the wall layout and index, the sinks' reach and the run-time estimate all take it here.
+    Works on numbers and arrays alike."""
+    return kappa * spacing
 
 
 @njit(inline="always", cache=True)

@@ -1,6 +1,6 @@
 """Local time stepping: each particle steps at its own power-of-two multiple of the finest step.
 
-With one global step, dt = cfl min_i h_i / (|v_i| + c_i) (method notes 2.7) is set by the
+With one global step, dt = cfl min_i h_i / (|v_i| + c_i) (``docs/method.md`` §5) is set by the
 fastest, finest particle, and every particle pays for it: at a breach the water is fast and
 deep, while most of the flood plain is slow and thin. Here a big step Delta = 2^K dt_f is cut
 into 2^K substeps of the finest step dt_f, and particle i advances with its own step

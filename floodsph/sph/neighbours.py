@@ -188,7 +188,7 @@ def _chunk_capacity(args, rows: np.ndarray) -> np.ndarray:
     if sample.shape[0] == 0:
         return np.zeros(0, dtype=np.int64)
     found = np.empty(sample.shape[0], dtype=np.int64)
-    _count(*args[:-1], sample, found)
+    _count(*args[:-1], sample, found)  # type: ignore[call-arg]  # a numba kernel
     first = np.arange(0, sample.shape[0], CHUNK // SAMPLE_STRIDE)
     mean = np.add.reduceat(found, first) / np.diff(np.append(first, sample.shape[0]))
     size = np.minimum(rows.shape[0] - first * SAMPLE_STRIDE, CHUNK)
@@ -235,19 +235,19 @@ def _lists(args, rows: np.ndarray, nbr_start: np.ndarray) -> np.ndarray:
     np.cumsum(_chunk_capacity(args, rows), out=base[1:])
     buf = np.empty(base[-1], dtype=np.int64)
     done = np.empty(nchunk, dtype=np.bool_)
-    _gather(*args, CHUNK, chunks, base, counts, buf, done)
+    _gather(*args, CHUNK, chunks, base, counts, buf, done)  # type: ignore[call-arg]  # a numba kernel
     passes = [(chunks[done], base[:-1][done], buf)]
     redo = chunks[~done]
     if redo.size:
         again = np.concatenate([rows[c * CHUNK:(c + 1) * CHUNK] for c in redo])
         found = np.empty(again.shape[0], dtype=np.int64)
-        _count(*args[:-1], again, found)
+        _count(*args[:-1], again, found)  # type: ignore[call-arg]  # a numba kernel
         first = np.append(0, np.cumsum(np.minimum(rows.shape[0] - redo * CHUNK, CHUNK))[:-1])
         base2 = np.zeros(redo.size + 1, dtype=np.int64)
         np.cumsum(np.add.reduceat(found, first) + 2, out=base2[1:])
         buf2 = np.empty(base2[-1], dtype=np.int64)
         fits = np.empty(redo.size, dtype=np.bool_)
-        _gather(*args, CHUNK, redo, base2, counts, buf2, fits)
+        _gather(*args, CHUNK, redo, base2, counts, buf2, fits)  # type: ignore[call-arg]  # a numba kernel
         if not fits.all():
             raise RuntimeError("neighbour lists: a chunk overflowed its exact size")
         passes.append((redo, base2[:-1], buf2))

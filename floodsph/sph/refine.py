@@ -1,6 +1,6 @@
 """Numba kernels of dynamic refinement: particle splitting and coalescing.
 
-Splitting (Vacondio, Rogers & Stansby, IJNMF 69 (2012) 1377-1410; method notes section 4).
+Splitting (Vacondio, Rogers & Stansby, IJNMF 69 (2012) 1377-1410; ``docs/method.md`` §6).
 A parent p becomes seven daughters k: one at the parent's position and six on a regular
 hexagon of radius eps h_p (eps = 0.4) turned so that one vertex points along the parent's
 velocity. Masses: m_vertex = f m_p with f = 0.136882287617319 and m_centre = (1 - 6 f) m_p,

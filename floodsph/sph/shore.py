@@ -81,7 +81,7 @@ def balance_shores(rows, x, y, u, v, rho, h, bed, dx, dy, elevation, sums, walle
     ``bed`` is the sample of ``floodsph.sph.bed.sample_bed`` (column ``BED``, b_i [m]);
     ``elevation`` the node-centred DEM grid with spacings dx, dy [m]; particles flagged in
     ``walled`` are left alone (their force is the wall's,
-    ``floodsph.walls.shadow.balance_walls``).
+    ``floodsph.sph.shadow.balance_walls``).
     """
     ny, nx = elevation.shape
     for k in prange(rows.shape[0]):

@@ -2,7 +2,7 @@
 pressure renormalisation, as named columns of one (n, SUMS) array.
 
 ``floodsph.sph.forces.internal_acceleration`` writes row i, with w the pair weight of the
-hydrostatic pressure term, r = x_i - x_j and d = rho / rho_w (method notes 2.5):
+hydrostatic pressure term, r = x_i - x_j and d = rho / rho_w (``docs/method.md`` §3.1, §4):
 
 * ``D_X``, ``D_Y``: D = - sum w (d_j - d_i) r [m s-2], the pressure force's difference part;
 * ``E_X``, ``E_Y``: E = - sum w r [s-2], its push per metre of i's own depth

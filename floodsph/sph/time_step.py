@@ -1,10 +1,10 @@
 """The leap-frog's kicks, implicit Manning friction and the CFL time step (pointwise kernels).
 
-Friction (method notes 2.5), implicit Manning, :func:`friction_factor`:
+Friction (``docs/method.md`` §3.6), implicit Manning, :func:`friction_factor`:
 
     v  <- 2 v / (1 + sqrt(1 + 4 beta)),  beta = dt g n^2 |v| / max(d, d_floor)^(4/3)
 
-Time step (method notes 2.7): dt = cfl min_i h_i / (|v_i| + c_i), c_i = sqrt(g d_i).
+Time step (``docs/method.md`` §5): dt = cfl min_i h_i / (|v_i| + c_i), c_i = sqrt(g d_i).
 
 Units: velocities [m s-1], accelerations [m s-2], rho [kg m-2], h [m], dt [s].
 """
@@ -29,27 +29,15 @@ def friction_factor(u, v, rho, n, dt, d_floor):
     v_new = v - dt g n^2 |v_new| v_new / d^(4/3): v_new is parallel to v, and its speed s
     solves s + (beta / |v|) s^2 = |v|. A particle kicked by a constant acceleration a then
     keeps Manning's terminal speed, a = g n^2 |v|^2 / d^(4/3), at any dt. The point-implicit
-    factor 1 / (1 + beta) of the method notes (2.5) settles at u_e (sqrt(beta_e^2 + 4) -
-    beta_e) / 2 with beta_e = dt g n^2 u_e / d^(4/3): 5 % slow at beta_e = 0.1, which the
-    long steps of slow, thin particles under local time stepping reach on a flood plain.
-    Like it, f lies in (0, 1], so friction cannot reverse the flow, for any dt.
+    factor 1 / (1 + beta) of the reference codes (``docs/method.md`` §3.6) settles at
+    u_e (sqrt(beta_e^2 + 4) - beta_e) / 2 with beta_e = dt g n^2 u_e / d^(4/3): 5 % slow at
+    beta_e = 0.1, which the long steps of slow, thin particles under local time stepping reach
+    on a flood plain. Like it, f lies in (0, 1], so friction cannot reverse the flow, for any dt.
     """
     d = max(rho / RHO_WATER, d_floor)
     speed = math.sqrt(u * u + v * v)
     beta = dt * GRAVITY * n * n * speed / d ** (4.0 / 3.0)
     return 2.0 / (1.0 + math.sqrt(1.0 + 4.0 * beta))
-
-
-@njit(parallel=True, cache=True)
-def apply_friction(u, v, rho, manning, dt, d_floor):
-    """Implicit Manning friction over dt: v <- f v (:func:`friction_factor`); n <= 0: none."""
-    for i in prange(u.shape[0]):
-        n = manning[i]
-        if n <= 0.0:
-            continue
-        k = friction_factor(u[i], v[i], rho[i], n, dt, d_floor)
-        u[i] *= k
-        v[i] *= k
 
 
 @njit(inline="always", cache=True)
@@ -80,8 +68,8 @@ def kick(u, v, ax, ay, half):
 @njit(parallel=True, cache=True)
 def close_step(u, v, ax, ay, half, rho, h, manning, dt, d_floor, cfl):
     """The end of a step in one pass: the closing half kick (:func:`kick`), implicit Manning
-    friction over dt (:func:`apply_friction`), and the next CFL step of :func:`stable_dt`,
-    which is returned [s]."""
+    friction over dt (v <- f v, :func:`friction_factor`; none where n <= 0), and the next CFL
+    step of :func:`stable_dt`, which is returned [s]."""
     best = np.inf
     for i in prange(u.shape[0]):
         u[i] += half * ax[i]

@@ -140,7 +140,7 @@ def _run(model, t_end):
     return time.perf_counter() - t0, model.counters["particle_updates"] - pst, pairs
 
 
-def _labels(model) -> tuple:
+def _labels(model) -> tuple[str, int, int, int, str]:
     """(refinement, particles_max, splits, merges, time_stepping) of a finished run, for
     ``CaseResult``."""
     c = model.counters

@@ -289,7 +289,7 @@ def thacker_shoreline(t, h0=10.0, a=3000.0, eta=1500.0, g=GRAVITY):
 def thacker_planar(x, y, t, h0=10.0, a=3000.0, eta=1500.0, g=GRAVITY):
     """Thacker's frictionless planar-surface oscillation in a paraboloidal basin.
 
-    Bed (the form of the method notes, minimum 0 at the origin):
+    Bed (minimum 0 at the origin; Thacker, J. Fluid Mech. 107 (1981) 499-508):
 
         b(x, y) = h0 (x^2 + y^2) / a^2.
 

@@ -35,13 +35,16 @@ for the density iterations and the forces.
 Modules, one job each:
 
 * ``geometry``: segments from polylines, distances, crossings, reflections;
-* ``layout``: the model's segments: the user's walls, the closed DEM sides and the nodata
-  border, cut at inflow openings and split at junctions;
 * ``nodata``: the nodata border of a DEM traced and simplified into polylines;
 * ``openings``, ``junctions``: cutting inflow sections out of walls; splitting at T-junctions;
 * ``index``: the near-wall lists of the particles;
 * ``sight``: pair blocking and the crossing guard;
 * ``images``: the mirror images;
-* ``seeding``: still-water seeds next to walls, settled and matched to the seeded depth;
-* ``shadow``: the boundary-integral alternative (``[numerics] wall_model = "integral"``).
+* ``seeding``: still-water seeds next to walls, settled and matched to the seeded depth.
+
+The package imports no other floodsph package. Two wall modules
+live where their users are: the model's segments (the user's walls, the closed DEM sides and
+the nodata border, cut at inflow openings and split at junctions) are assembled in
+``floodsph.model.wall_layout``, and the boundary-integral alternative
+(``[numerics] wall_model = "integral"``), an integral of the kernel, is ``floodsph.sph.shadow``.
 """

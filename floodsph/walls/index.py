@@ -321,14 +321,14 @@ def _corner_partners(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     vertex = vertex.ravel()
     order = np.argsort(vertex, kind="stable")
     cut = np.flatnonzero(np.diff(vertex[order])) + 1
-    pairs = set()
+    found: set[tuple[int, int]] = set()
     for group in np.split(order // 2, cut):
         for a in range(group.size):
             for b in range(a + 1, group.size):
                 s1, s2 = sorted((int(group[a]), int(group[b])))
                 if s1 != s2 and right_corner(seg, s1, s2):
-                    pairs.add((s1, s2))
-    pairs = np.array(sorted(pairs), dtype=np.int64).reshape(-1, 2)
+                    found.add((s1, s2))
+    pairs = np.array(sorted(found), dtype=np.int64).reshape(-1, 2)
     pstart = np.zeros(ns + 1, dtype=np.int64)
     np.cumsum(np.bincount(pairs[:, 0], minlength=ns), out=pstart[1:])
     return pstart, np.ascontiguousarray(pairs[:, 1])

@@ -14,7 +14,7 @@ few long segments:
    the staircase (every skipped vertex on the chord or left of it) and within ``tolerance``
    of it, with no valid cell on their right. Every valid cell therefore stays inside the walls;
    the slivers of nodata cells between a chord and the staircase become wet area, with the
-   nearest valid elevation the DEM reader gives nodata cells (``floodsph.io.dem``), and
+   nearest valid elevation the DEM reader gives nodata cells (``floodsph.inputs.dem``), and
    initial water fills them (:func:`walled_slivers`).
 
 Coordinates are local metres with row 0 south, as in ``floodsph.model.terrain``.

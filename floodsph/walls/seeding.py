@@ -2,7 +2,7 @@
 
 Water is seeded on a square lattice of spacing dx with m_i = rho_w d_i dx^2
 (``floodsph.inputs.initial_water``). In a full kernel support the SPH depth of such a lattice is the
-seeded d, and still water is an equilibrium (method notes 1.4). Next to a wall the mirror
+seeded d, and still water is an equilibrium (``docs/method.md`` §2). Next to a wall the mirror
 images (``floodsph.walls``) complete the support exactly only where the lattice rows run
 along the wall, half a spacing from it. Along an oblique wall (a nodata chord, a user's
 embankment) the seeds lie at every distance from it, and their images crowd them or leave

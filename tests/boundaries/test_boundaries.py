@@ -17,10 +17,11 @@ from sph_cases import lattice, particles_with_depth, run_until
 
 from floodsph.boundaries import Inflow, Sink
 from floodsph.boundaries.inflow import lattice_alpha_ratio
+from floodsph.boundaries.open_edges import SIDES
 from floodsph.boundaries.riemann import critical_depth, inflow_state
 from floodsph.constants import GRAVITY
 from floodsph.errors import InputError
-from floodsph.inputs.hydrograph import Hydrograph
+from floodsph.io.hydrograph import Hydrograph
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
@@ -168,7 +169,7 @@ def test_still_water_at_an_open_edge_does_not_drain():
     terrain = _flat(300, 100)
     x, y = lattice(0, 300, 0, 100, 10.0)
     model = set_up_model(terrain, particles_with_depth(x, y, np.full(x.shape, 2.0), 10.0, KAPPA),
-                       Numerics(particle_spacing_m=10.0), closed_edges=("south", "north", "west"))
+                       Numerics(particle_spacing_m=10.0), closed_sides=("south", "north", "west"))
     v0 = model.volume()
     run_until(model, 200.0)
     p = model.particles
@@ -190,7 +191,7 @@ def test_uniform_flow_in_a_sloping_channel_stays_normal():
     inflow = Inflow([[0, 0], [0, width]], Hydrograph([0.0, 1e6], [q * width] * 2), dx, KAPPA,
                     terrain)
     model = set_up_model(terrain, particles, Numerics(particle_spacing_m=dx),
-                       closed_edges=("south", "north", "west"), boundaries=[inflow])
+                       closed_sides=("south", "north", "west"), boundaries=[inflow])
     for t in (50.0, 100.0, 150.0, 200.0):
         run_until(model, t)
         p, d = model.particles, model.depth()
@@ -209,7 +210,7 @@ def _dam_break(length, d_left, d_right, closed, dx=10.0):
     depth = np.where(x < 1000.0, d_left, d_right)
     wet = depth > 0
     return set_up_model(terrain, particles_with_depth(x[wet], y[wet], depth[wet], dx, KAPPA),
-                      Numerics(particle_spacing_m=dx), closed_edges=closed)
+                      Numerics(particle_spacing_m=dx), closed_sides=closed)
 
 
 def _profile(model, xq):
@@ -227,7 +228,7 @@ def test_waves_leave_an_open_edge_without_reflection(d_right, t_end):
     front has left, the depth upstream of the cut matches a channel twice as long, and the
     exact solution, as closely as the long channel does."""
     short = _dam_break(1300.0, 10.0, d_right, ("south", "north", "west"))
-    long_ = _dam_break(2600.0, 10.0, d_right, True)
+    long_ = _dam_break(2600.0, 10.0, d_right, SIDES)
     v0 = short.volume()
     run_until(short, t_end)
     run_until(long_, t_end)

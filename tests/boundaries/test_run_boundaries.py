@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from conftest import CELL, NX, NY, X0, Y0
 
-from floodsph.inputs.hydrograph import read_hydrograph
+from floodsph.io.hydrograph import read_hydrograph
 from floodsph.run.pipeline import run_scenario
 from floodsph.scenario.reader import load_scenario
 

@@ -18,7 +18,7 @@ from floodsph.breach import (
 from floodsph.breach.storage import Storage, read_storage_table
 from floodsph.cli.breach import command
 from floodsph.errors import InputError
-from floodsph.inputs.hydrograph import Hydrograph, read_hydrograph
+from floodsph.io.hydrograph import Hydrograph, read_hydrograph
 
 # Documented example: V_w = 1e7 m3, h_b = h_w = 20 m (SI), g = 9.81 m/s2.
 V_W, H_B = 1.0e7, 20.0

@@ -12,7 +12,7 @@ from rasterio.transform import Affine, from_origin
 from rasterio.warp import transform as warp_transform
 
 from floodsph.errors import InputError
-from floodsph.io.dem import load_terrain
+from floodsph.inputs.dem import load_terrain
 
 UTM32 = "EPSG:32632"
 
@@ -167,7 +167,7 @@ def test_geographic_dem_reprojected_to_utm(tmp_path, caplog):
     lat = lat1 - (r + 0.5) * res
     z = 100.0 + 2000.0 * (lon - lon0) + 1000.0 * (lat - 45.0)
     path = write_tif(tmp_path / "geo.tif", z, from_origin(lon0, lat1, res, res), "EPSG:4326")
-    with caplog.at_level(logging.WARNING, logger="floodsph.io.dem"):
+    with caplog.at_level(logging.WARNING, logger="floodsph.inputs.dem"):
         ter = load_terrain(path)
     assert CRS.from_wkt(ter.crs_wkt).to_epsg() == 32632
     assert "EPSG:32632" in caplog.text
@@ -279,7 +279,7 @@ def test_malpasset_dem():
 
 
 def test_utm_zone_choice():
-    from floodsph.io.dem import utm_crs_for
+    from floodsph.inputs.dem import utm_crs_for
 
     assert utm_crs_for(6.76, 43.51).to_epsg() == 32632  # Malpasset, France
     assert utm_crs_for(-70.65, -33.45).to_epsg() == 32719  # Santiago de Chile

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from floodsph.errors import InputError
-from floodsph.inputs.hydrograph import Hydrograph, read_hydrograph, write_hydrograph_csv
+from floodsph.io.hydrograph import Hydrograph, read_hydrograph, write_hydrograph_csv
 
 
 def _csv(tmp_path, text, name="q.csv"):

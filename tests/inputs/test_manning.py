@@ -6,7 +6,7 @@ import rasterio
 from rasterio.transform import from_origin
 
 from floodsph.errors import InputError
-from floodsph.io.dem import load_terrain
+from floodsph.inputs.dem import load_terrain
 from floodsph.io.manning import read_manning_table, worldcover_table_path
 
 UTM32 = "EPSG:32632"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from sph_cases import lattice, particles_with_depth
 
-from floodsph.boundaries.open_edges import OpenEdges
+from floodsph.boundaries.open_edges import SIDES, OpenEdges
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
@@ -26,10 +26,10 @@ def _lake(extra_x=()):
 
 def test_the_open_sides_get_transmissive_ghosts_ahead_of_the_other_boundaries():
     terrain, p = _lake()
-    model = set_up_model(terrain, p, Numerics(particle_spacing_m=DX), closed_edges=("west",))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=DX), closed_sides=("west",))
     assert isinstance(model.boundaries[0], OpenEdges)
     assert sorted(model.boundaries[0].sides) == ["east", "north", "south"]
-    closed = set_up_model(*_lake(), Numerics(particle_spacing_m=DX), closed_edges=True)
+    closed = set_up_model(*_lake(), Numerics(particle_spacing_m=DX), closed_sides=SIDES)
     assert not any(isinstance(b, OpenEdges) for b in closed.boundaries)
 
 
@@ -38,7 +38,7 @@ def test_seeds_off_the_grid_leave_as_outflow_and_the_volume_adds_up():
     volume is the model's ``volume_out``, and what stays plus what left is what was seeded."""
     terrain, p = _lake(extra_x=(110.0, 130.0))
     seeded = p.volume()
-    model = set_up_model(terrain, p, Numerics(particle_spacing_m=DX), closed_edges=False)
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=DX), closed_sides=())
     assert model.volume_out == pytest.approx(2 * 2.0 * DX * DX, rel=1e-12)
     assert model.volume() + model.volume_out == pytest.approx(seeded, rel=1e-12)
     assert model.particles.x.max() < terrain.width
@@ -46,7 +46,7 @@ def test_seeds_off_the_grid_leave_as_outflow_and_the_volume_adds_up():
 
 def test_bad_set_up_arguments_are_refused_by_name():
     terrain, p = _lake()
-    with pytest.raises(ValueError, match=r"closed_edges: unknown sides \['up'\]"):
-        set_up_model(terrain, p, Numerics(particle_spacing_m=DX), closed_edges=("up",))
+    with pytest.raises(ValueError, match=r"closed_sides: unknown sides \['up'\]"):
+        set_up_model(terrain, p, Numerics(particle_spacing_m=DX), closed_sides=("up",))
     with pytest.raises(ValueError, match="particle_spacing_m must be given"):
         set_up_model(terrain, p, Numerics())

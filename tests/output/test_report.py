@@ -153,8 +153,8 @@ def test_the_page_is_self_contained_with_every_picture_embedded(run_dir):
     for src in sources:
         assert src.startswith("data:image/png;base64,")
         assert base64.b64decode(src.split(",", 1)[1])[:8] == b"\x89PNG\r\n\x1a\n"
+    from floodsph.io.run_names import SERIES_PICTURE_NAMES
     from floodsph.output.pictures import SERIES_PICTURES
-    from floodsph.run.folder import SERIES_PICTURE_NAMES
 
     assert SERIES_PICTURES == SERIES_PICTURE_NAMES
     assert set(SERIES_PICTURE_NAMES) <= set(json.loads(

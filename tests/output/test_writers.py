@@ -13,6 +13,7 @@ from rasterio.transform import from_origin
 import floodsph
 from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
+from floodsph.io.run_names import PICTURE_NAMES
 from floodsph.model.terrain import Terrain
 from floodsph.output import write_maps
 from floodsph.output.envelopes import MAPS, Envelopes
@@ -20,7 +21,6 @@ from floodsph.output.gauges import Gauges, read_gauge_file
 from floodsph.output.geotiff import write_geotiff
 from floodsph.output.grid import OutputGrid
 from floodsph.output.netcdf import SnapshotWriter, write_flood_maps
-from floodsph.run.folder import PICTURE_NAMES
 
 X0, Y0, CELL = 431000.0, 5012000.0, 5.0
 CRS_UTM = CRS.from_epsg(32632)

@@ -1,4 +1,4 @@
-"""Checkpoint and resume (scenario-format.md, "Checkpoints and resuming a run").
+"""Checkpoint and resume (docs/run-folder.md, "Checkpoints and `--resume`").
 
 A run stopped by SIGTERM and resumed, any number of times, writes the same maps, gauges and
 mass balance as the run that was never stopped: bit for bit, with refinement, inflows, open

@@ -163,8 +163,8 @@ def test_debug_shows_the_exception(tmp_path):
 
 
 def test_check_reports_what_seeding_gives(scenario_file):
+    from floodsph.inputs.dem import load_terrain
     from floodsph.inputs.initial_water import depth_from_level, seed_particles
-    from floodsph.io.dem import load_terrain
 
     terrain = load_terrain(scenario_file.parent / "dem.tif", manning=0.03)
     polygon = np.array([[0, 0], [400, 0], [400, 200], [0, 200]], dtype=float)

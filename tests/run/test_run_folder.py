@@ -1,4 +1,4 @@
-"""Run-folder safety and the ending of every run (scenario-format.md, "Run-folder safety").
+"""Run-folder safety and the ending of every run (docs/run-folder.md, "Safety rules").
 
 Each test is a hostile but ordinary situation: an output folder that holds the user's files,
 a replacement that fails, two runs into one folder, a signal from a batch scheduler, a full

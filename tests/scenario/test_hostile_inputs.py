@@ -563,7 +563,7 @@ def test_dem_with_a_vertical_crs_in_metres_is_read_as_is(valley_dem, scenario_fi
 
 
 def test_bom_gauge_file_reads_the_same_points(valley_dem, tmp_path):
-    from floodsph.io.dem import load_terrain
+    from floodsph.inputs.dem import load_terrain
     from floodsph.output.gauges import read_gauge_file
 
     terrain = load_terrain(valley_dem)
@@ -579,7 +579,7 @@ def test_bom_gauge_file_reads_the_same_points(valley_dem, tmp_path):
 
 
 def test_bom_manning_table_and_hydrograph_read_the_same_values(tmp_path):
-    from floodsph.inputs.hydrograph import read_hydrograph
+    from floodsph.io.hydrograph import read_hydrograph
     from floodsph.io.manning import read_manning_table
 
     table = "class,name,manning_n\n10,forêt,0.12\n30,prairie,0.035\n"

@@ -1,6 +1,6 @@
 """``floodsph.scenario.numerics.Numerics``: one set of solver settings from the scenario's
 [numerics]
-to the model, with the scenario-format.md keys as its field names."""
+to the model, with the scenario keys (docs/scenario-reference.md) as its field names."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from floodsph.scenario.numerics import SCENARIO_KEYS, Numerics, NumericsError, S
 from floodsph.scenario.reader import load_scenario
 
 CONTRACT_KEYS = {"particle_spacing_m", "cfl", "refinement", "threads"}
-"""The [numerics] keys of scenario-format.md's example."""
+"""The [numerics] keys of a scenario's example (docs/scenario-reference.md)."""
 
 
 def test_the_scenario_keys_are_the_contracts_and_the_inner_tunables_are_none_of_them():

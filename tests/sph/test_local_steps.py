@@ -88,7 +88,7 @@ def test_local_steps_conserve_momentum_to_the_order_of_the_step():
     p = particles_with_depth(x, y, d, 8.0, 1.3, u=rng.normal(0, 1, x.size) + 2.0,
                              v=rng.normal(0, 1, x.size) - 1.0)
     numerics = Numerics(particle_spacing_m=8.0, kappa=1.3, time_stepping=TimeStepping.LOCAL)
-    model = set_up_model(terrain, p, numerics, closed_edges=False)
+    model = set_up_model(terrain, p, numerics, closed_sides=())
     mom0 = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     run_until(model, 20.0)
     assert model.volume_out == 0.0

@@ -36,7 +36,7 @@ def test_momentum_changes_only_through_external_forces():
                              v=rng.normal(0, 1, x.size) - 1.0)
     model = set_up_model(terrain, p, Numerics(particle_spacing_m=8.0, kappa=1.3,
                                               time_stepping=TimeStepping.GLOBAL),
-                         closed_edges=False)
+                         closed_sides=())
     mom0 = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     scale = (p.m * np.hypot(p.u, p.v)).sum()
     run_until(model, 20.0)

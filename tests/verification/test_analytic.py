@@ -173,7 +173,7 @@ def test_stoker_rejects_inverted_depths():
 def test_thacker_period_and_shoreline():
     T = thacker_period(10.0, 3000.0)
     assert T == pytest.approx(2 * math.pi * 3000.0 / math.sqrt(2 * G * 10.0))
-    assert 1340 < T < 1350  # method notes: T ~ 1345 s
+    assert 1340 < T < 1350  # Thacker's period 2 pi a / sqrt(2 g h0) ~ 1345 s
     for t in (0.0, 0.3 * T, 0.8 * T):
         xc, yc, r = thacker_shoreline(t)
         assert thacker_planar(xc, yc, t)[0] == pytest.approx(10.0, rel=1e-12)

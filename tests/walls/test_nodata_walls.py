@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
+from floodsph.boundaries.open_edges import SIDES
 from floodsph.constants import RHO_WATER
 from floodsph.inputs.initial_water import seed_particles, wet_cells
 from floodsph.model.builder import set_up_model
@@ -164,7 +165,7 @@ def lake_model(slivers=True):
     wet = wet_cells(terrain, walled=slivers)
     p = seed_particles(terrain, np.where(wet, 2.0, 0.0), 5.0, Numerics.kappa, wet=wet)
     volume = float(np.sum(p.m[:p.n]) / RHO_WATER)
-    model = set_up_model(terrain, p, Numerics(particle_spacing_m=5.0), closed_edges=True)
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=5.0), closed_sides=SIDES)
     return terrain, model, volume
 
 

@@ -1,11 +1,11 @@
-"""The boundary integral of floodsph.walls.shadow against a brute-force quadrature of the
+"""The boundary integral of floodsph.sph.shadow against a brute-force quadrature of the
 kernel over the points that walls hide, and its continuity past vertices."""
 
 import numpy as np
 import pytest
 
 from floodsph.sph.kernels import SIGMA_2D
-from floodsph.walls.shadow import shadow, tail
+from floodsph.sph.shadow import shadow, tail
 
 H = 6.0
 

@@ -220,7 +220,7 @@ def test_dry_gauge_samples_count_as_zero_depth(tmp_path):
 @needs_ea4
 def test_ea4_scenario_and_hydrograph_written_to_the_contract(tmp_path):
     from floodsph.cli.main import cli
-    from floodsph.inputs.hydrograph import read_hydrograph
+    from floodsph.io.hydrograph import read_hydrograph
     from floodsph.scenario.reader import load_scenario
 
     path = ea4.write_inputs(EA4_DATA, tmp_path, 18000.0, 10, 10.0)

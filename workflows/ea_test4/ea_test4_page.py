@@ -228,7 +228,7 @@ def main(argv=None) -> int:
         print("ANUGA is not installed (pip install anuga) and no --anuga-run was given: the "
               "page is not made.", file=sys.stderr)
         return 0
-    from floodsph.inputs.hydrograph import read_hydrograph
+    from floodsph.io.hydrograph import read_hydrograph
     from floodsph.run.manifest import read_manifest
 
     work = args.work.resolve()

@@ -86,7 +86,7 @@ def write_inputs(folder: Path, out: Path, end_time: float, dem_cell: int,
     ``numerics.refinement`` (None: floodsph's default)."""
     from tomli_w import dumps
 
-    from floodsph.inputs.hydrograph import read_hydrograph, write_hydrograph_csv
+    from floodsph.io.hydrograph import read_hydrograph, write_hydrograph_csv
 
     hydrograph = read_hydrograph(folder / HYDROGRAPH_NAME, "EA test 4 hydrograph")
     write_hydrograph_csv(out / "ea4_hydrograph.csv", hydrograph.t, hydrograph.Q)
@@ -257,7 +257,7 @@ def main(argv=None) -> int:
               "ea_test4/ (or place it in <repo>/../shared/benchmarks); nothing run.",
               file=sys.stderr)
         return 0
-    from floodsph.inputs.hydrograph import read_hydrograph
+    from floodsph.io.hydrograph import read_hydrograph
     from floodsph.run.pipeline import run_scenario
     from floodsph.scenario.reader import load_scenario
 

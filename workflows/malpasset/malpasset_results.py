@@ -1,6 +1,6 @@
 """Malpasset results: levels and arrival times at the survey points, costs, pictures.
 
-From a finished run folder (scenario-format.md file names) and the benchmark points:
+From a finished run folder (the file names of docs/run-folder.md) and the benchmark points:
 
 * maximum water level at a point: ``max_level.tif`` in the cell holding the point
   (``max_level_m``), and the highest maximum level among the cells within ``RADIUS_M`` whose

@@ -168,7 +168,7 @@ def write_gauges(points: list[dict], path: Path) -> Path:
 def scenario_dict(dem: str, bounds, sea: str, end_time: float, spacing: float,
                   gauges: str | None = None, gauge_interval: float = 5.0,
                   sea_outline_ring: list | None = None, numerics: dict | None = None) -> dict:
-    """The Malpasset scenario (scenario-format.md) as plain data for ``tomli_w.dumps``.
+    """The Malpasset scenario (docs/scenario-reference.md) as plain data for ``tomli_w.dumps``.
 
     ``sea`` is one of SEA_MODES; ``"sink"`` needs ``sea_outline_ring`` (:func:`sea_outline`).
     ``numerics``: further keys of the ``[numerics]`` table, such as ``refinement`` (default:

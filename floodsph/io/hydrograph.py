@@ -1,7 +1,7 @@
 """Discharge hydrographs Q(t): read, evaluate, integrate and write the ``time_s,discharge_m3s`` CSV.
 
-The CSV format (scenario-format.md, ``[[inflows]] hydrograph``) is a header line naming one
-time column and one discharge column, in any order, followed by one row per sample:
+The CSV format (``docs/scenario-reference.md``, ``[[inflows]] hydrograph``) is a header line
+naming one time column and one discharge column, in any order, followed by one row per sample:
 
 * time as ``time_s`` (seconds), ``time_min`` (minutes) or ``time_h`` (hours), or ``time``
   holding ISO 8601 instants (``2024-05-01T06:00:00+02:00``; one without a UTC offset is UTC,
@@ -30,10 +30,10 @@ from pathlib import Path
 
 import numpy as np
 
+from floodsph.constants import LARGEST_VALUE
 from floodsph.errors import InputError
+from floodsph.io.atomic_files import atomic_path
 from floodsph.io.text import read_csv_rows
-from floodsph.run.atomic_files import atomic_path
-from floodsph.scenario.schema import LARGEST_VALUE
 
 TIME_COLUMN = "time_s"
 DISCHARGE_COLUMN = "discharge_m3s"

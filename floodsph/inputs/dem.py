@@ -37,7 +37,6 @@ from rasterio.warp import calculate_default_transform, reproject, transform_boun
 from scipy import ndimage
 
 from floodsph.checks.elevation import check_elevations, vertical_unit
-from floodsph.checks.roughness import N_DEFAULT
 from floodsph.errors import InputError, warn
 from floodsph.io.crs import (
     SCALE_TOLERANCE,
@@ -49,7 +48,8 @@ from floodsph.io.crs import (
 )
 from floodsph.io.manning import manning_grid
 from floodsph.io.mosaic import read_dem_grid, tile_names
-from floodsph.io.raster import Grid, GridHeader, crs_label, parse_crs
+from floodsph.io.raster import Grid, GridHeader, crs_label, crs_wkt, parse_crs
+from floodsph.io.roughness import N_DEFAULT
 from floodsph.model.terrain import Terrain
 
 log = logging.getLogger(__name__)
@@ -140,9 +140,9 @@ def load_terrain(
         manning=n[::-1].copy(),
         x0=t.c,
         y0=t.f + t.e * rows,
-        crs_wkt=grid.crs.to_wkt(),
+        crs_wkt=crs_wkt(grid.crs),
         valid=valid[::-1].copy(),
-        source_crs_wkt=source_crs.to_wkt(),
+        source_crs_wkt=crs_wkt(source_crs),
         source_scale=scales,
         coordinates_crs_wkt=None if user_crs is None else user_crs.to_wkt(),
     )
@@ -158,7 +158,7 @@ def check_dem_size(shape: tuple[int, int], path) -> None:
             f"{MIN_CELLS} cells)")
 
 
-def _elevations_in_metres(grid: Grid, path: Path, warnings) -> Grid:
+def _elevations_in_metres(grid: Grid, path: str | Path, warnings) -> Grid:
     """Refuse undeclared fill values; convert elevations in feet (or any stated length unit
     pyproj knows) to metres, with a warning; the result has the horizontal CRS only."""
     unit = vertical_unit(grid.crs, grid.units)
@@ -184,7 +184,7 @@ def horizontal_crs(crs: CRS) -> CRS:
     return CRS.from_wkt(full.sub_crs_list[0].to_wkt())
 
 
-def _to_ground_metres(grid: Grid, path: Path, warnings=None
+def _to_ground_metres(grid: Grid, path: str | Path, warnings=None
                       ) -> tuple[Grid, tuple[float, float] | None]:
     """The grid in a projected CRS of ground metres, and the scale factor range found in the
     file's CRS (None when geographic): feet converted, a geographic or distorting CRS
@@ -199,7 +199,7 @@ def _to_ground_metres(grid: Grid, path: Path, warnings=None
         cell = metric_cell_size(grid.transform, grid.shape)
         utm = _reproject_to_utm(grid, cell)
         warn(f"DEM {path} is in geographic coordinates ({crs_label(crs.to_wkt())}); "
-             f"reprojected to {crs_label(utm.crs.to_wkt())} with {cell:.3g} m square cells",
+             f"reprojected to {crs_label(crs_wkt(utm.crs))} with {cell:.3g} m square cells",
              warnings)
         return utm, None
     if not crs.is_projected:
@@ -220,7 +220,7 @@ def _to_ground_metres(grid: Grid, path: Path, warnings=None
     warn(f"DEM {path}: its CRS {crs_label(crs.to_wkt())} has a point scale factor of "
          f"{scales[0]:.4f} to {scales[1]:.4f} over the domain ({k:.4f} at its centre), beyond "
          f"1 +- {SCALE_TOLERANCE:.1%}: its lengths are not ground metres; reprojected to "
-         f"{crs_label(utm.crs.to_wkt())} with {cell:.3g} m square cells", warnings)
+         f"{crs_label(crs_wkt(utm.crs))} with {cell:.3g} m square cells", warnings)
     return utm, scales
 
 
@@ -267,7 +267,7 @@ def utm_crs_for(lon: float, lat: float) -> CRS:
              if info.name.endswith(hemisphere)]
     if not found:
         raise InputError(f"no UTM zone covers longitude {lon:g}, latitude {lat:g}")
-    eastern = max(found, key=lambda info: info.area_of_use.west)
+    eastern = max(found, key=lambda info: info.area_of_use.west if info.area_of_use else -180.0)
     return CRS.from_epsg(int(eastern.code))
 
 
@@ -352,6 +352,7 @@ def _reproject_to_utm(grid: Grid, cell: float) -> Grid:
     t = grid.transform
     west, north = t.c, t.f
     east, south = west + t.a * cols, north + t.e * rows
+    assert grid.crs is not None  # a DEM without a CRS is refused when it is read
     to_lonlat = pyproj.Transformer.from_crs(pyproj.CRS.from_wkt(grid.crs.to_wkt()),
                                             "EPSG:4326", always_xy=True)
     lon, lat = to_lonlat.transform(0.5 * (west + east), 0.5 * (south + north))
@@ -375,7 +376,7 @@ def _reproject_to_utm(grid: Grid, cell: float) -> Grid:
     return Grid(out, dst_t, dst_crs)
 
 
-def _crop(grid: Grid, extent, path: Path) -> Grid:
+def _crop(grid: Grid, extent, path: str | Path) -> Grid:
     """Keep the whole cells that overlap ``[xmin, ymin, xmax, ymax]``."""
     try:
         xmin, ymin, xmax, ymax = (float(v) for v in extent)
@@ -403,7 +404,8 @@ def _crop(grid: Grid, extent, path: Path) -> Grid:
     return Grid(values, new_t, grid.crs)
 
 
-def _fill_nodata(z: np.ndarray, max_cells: int, path: Path) -> tuple[np.ndarray, np.ndarray]:
+def _fill_nodata(z: np.ndarray, max_cells: int, path: str | Path
+                 ) -> tuple[np.ndarray, np.ndarray]:
     """Fill small interior holes; mark the other nodata invalid and give it finite values.
 
     Holes are the 8-connected nodata regions; one of at most ``max_cells`` cells that does

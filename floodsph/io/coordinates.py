@@ -3,7 +3,7 @@
 The scenario's inline coordinates (``initial_water.polygon``, ``walls.polyline``,
 ``inflows.line`` and ``direction``, ``sinks.polygon``, ``terrain.extent``, the x and y of a
 gauges CSV) are in the DEM file's own CRS, or in ``[scenario] crs`` when that is given. The
-model runs in ground metres (``floodsph.io.dem``): the DEM file's CRS itself, or the UTM zone
+model runs in ground metres (``floodsph.inputs.dem``): the DEM file's CRS itself, or the UTM zone
 a geographic or distorting DEM was reprojected to, or the metre version of a CRS in feet. The
 inline coordinates are transformed into that CRS here (pyproj, longitude/easting first), once,
 before any check; vector files are reprojected from their own CRS by ``floodsph.io.vector``.
@@ -42,7 +42,9 @@ def moved(terrain) -> bool:
 
 
 def _transformer(terrain, inverse: bool = False) -> pyproj.Transformer:
-    user = pyproj.CRS.from_wkt(coordinates_wkt(terrain))
+    wkt = coordinates_wkt(terrain)
+    assert wkt is not None  # only called where the coordinates are moved (:func:`moved`)
+    user = pyproj.CRS.from_wkt(wkt)
     model = pyproj.CRS.from_wkt(terrain.crs_wkt)
     return pyproj.Transformer.from_crs(model, user, always_xy=True) if inverse else \
         pyproj.Transformer.from_crs(user, model, always_xy=True)

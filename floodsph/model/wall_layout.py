@@ -8,6 +8,8 @@ sight tests see each junction as a shared vertex.
 
 from __future__ import annotations
 
+from collections.abc import Set as AbstractSet
+
 import numpy as np
 
 from floodsph.boundaries.open_edges import SIDES
@@ -21,7 +23,7 @@ SIDE_EXTENSION_H = 6.0
 """How far [h0] a closed side runs on beyond an open side it meets (:func:`side_segments`)."""
 
 
-def model_segments(terrain: Terrain, walls, closed: set, nodata_walled: bool, openings,
+def model_segments(terrain: Terrain, walls, closed: AbstractSet[str], nodata_walled: bool, openings,
                    h0: float, spacing: float) -> np.ndarray:
     """All wall segments (ns, 4) [m, local] of a model.
 
