@@ -221,11 +221,13 @@ class FloodModel:
     def move(self, dt: float) -> None:
         """Drift every particle by dt (walls reflect), let the open boundaries act, drop what
         left the domain, and advance density and h by the continuity guess. Under the balanced
-        momentum the level offsets of moving water fade with the distance travelled
-        (``floodsph.sph.level_offsets``)."""
+        momentum the level offsets of moving water fade with the distance travelled, and still
+        water held by its banks is damped and tethered (``floodsph.sph.level_offsets``)."""
         p = self.particles
         if self.balanced:
             level_offsets.decay_offsets(p.u, p.v, p.h, dt, p.bank_held, p.eta_offset)
+            level_offsets.hold_still(p.u, p.v, p.x, p.y, p.x_seed, p.y_seed, p.bank_held, dt,
+                                     level_momentum.HOLD_TIME, level_momentum.HOLD_STIFFNESS)
         self.counters["wall_reflections"] += int(sight.drift(
             p.x, p.y, p.u, p.v, dt, self.walls_near.wstart, self.walls_near.wseg, self.seg))
         self._nl_here = False
@@ -432,6 +434,11 @@ class FloodModel:
         if not self.balanced:
             self._variational_forces(rows)
             return
+        if self.eta.shape[0] != p.n:
+            self.eta = np.empty(p.n)
+            self.ghost = np.zeros(p.n)
+        level_offsets.levels(p.x, p.y, p.rho, p.eta_offset, t.elevation, t.dx, t.dy, self.eta)
+        self._release(rows)
         weight = level_momentum.variational_weight(p.u[rows], p.v[rows])
         moving = rows[weight > 0.0]
         if moving.size:
@@ -474,24 +481,26 @@ class FloodModel:
 
     def _balanced_forces(self, rows: np.ndarray) -> None:
         """The balanced momentum's accelerations of the particles ``rows``
-        (``floodsph.sph.level_momentum``), on the levels of all particles."""
+        (``floodsph.sph.level_momentum``), on the levels of all particles (``self.eta``)."""
         p = self.particles
         t = self.terrain
-        if self.eta.shape[0] != p.n:
-            self.eta = np.empty(p.n)
-            self.ghost = np.zeros(p.n)
-        level_offsets.levels(p.x, p.y, p.rho, p.eta_offset, t.elevation, t.dx, t.dy, self.eta)
         level_momentum.balanced_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                              self.eta, self.bed, self.nl.start, self.nl.nbr,
                                              self.blocked, self.wall_lists(), t.elevation,
                                              self.held, p.bank_held, p.eta_seed, t.dx, t.dy,
                                              p.ax, p.ay, p.divv, self.ghost)
+        forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
+                                    p.ay, 0.0, -GRAVITY)
+
+    def _release(self, rows: np.ndarray) -> None:
+        """Release the still water held by its banks among ``rows`` that moves at
+        ``EDGE_SPEED`` or whose level ``self.eta`` departs from its seeded level by
+        ``HOLD_LEVEL`` (``floodsph.sph.level_momentum``)."""
+        p = self.particles
         held = rows[p.bank_held[rows] == level_offsets.HELD]
         moved = ((p.u[held] ** 2 + p.v[held] ** 2 >= level_momentum.EDGE_SPEED ** 2)
                  | (np.abs(self.eta[held] - p.eta_seed[held]) >= level_momentum.HOLD_LEVEL))
         p.bank_held[held[moved]] = level_offsets.RELEASED
-        forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
-                                    p.ay, 0.0, -GRAVITY)
 
     def match_levels(self) -> int:
         """Give every particle seeded at rest the level offset that makes its level its seeded
@@ -512,4 +521,6 @@ class FloodModel:
         free_edge[:evaluated] = self.ghost[:evaluated] > 0.0
         at_rest = np.isfinite(p.eta_seed) & (p.u == 0.0) & (p.v == 0.0)
         p.bank_held[:] = np.where(at_rest & ~free_edge, level_offsets.HELD, level_offsets.FREE)
+        p.x_seed[:] = p.x
+        p.y_seed[:] = p.y
         return matched

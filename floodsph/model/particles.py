@@ -44,6 +44,9 @@ FIELDS: dict[str, tuple[type, str]] = {
                              "(NaN for water seeded moving, injected or born in the run)"),
     "bank_held": (np.int64, "1 for water seeded at rest whose support had no free edge at "
                             "set-up: it keeps none until it moves (floodsph.sph.level_momentum)"),
+    "x_seed": (np.float64, "m, local easting of still water held by its banks at set-up "
+                           "(floodsph.sph.level_offsets.hold_still)"),
+    "y_seed": (np.float64, "m, the same, northing"),
     "pid": (np.int64, "unique particle id, never reused"),
 }
 
@@ -109,7 +112,7 @@ class ParticleSet:
 
         ``u, v`` default to 0, ``h0``/``rho0`` to the given ``h``/``rho``, ``alpha`` to
         2 rho (its lattice value), ``hgrow`` to 1, ``level``, ``born``, ``stride`` and
-        ``eta_offset`` and ``bank_held`` to 0, ``eta_seed`` to NaN.
+        ``eta_offset`` and ``bank_held`` to 0, ``eta_seed``, ``x_seed`` and ``y_seed`` to NaN.
         New ids are assigned.
         Returns the slice of the new particles.
         """
@@ -140,6 +143,8 @@ class ParticleSet:
             "eta_offset": 0.0,
             "eta_seed": np.nan,
             "bank_held": 0,
+            "x_seed": np.nan,
+            "y_seed": np.nan,
         }
         start = self.n
         self._reserve(start + count)

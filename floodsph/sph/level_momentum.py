@@ -52,13 +52,17 @@ its banks were tested once, on the seeded lake. Where its support is cut (|e_i| 
 L_i, the seeded level, adds (L_i - eta_i) e_i to S_i and completes N_i as the dry ghost does.
 It is zero at rest, and pushes a particle whose level fell back among its neighbours.
 
-Held water is also damped, a_i -= v_i / ``HOLD_TIME``. Measured on the Malpasset reservoir
-disturbed by 1e-6 m/s, with the bank ghost and the held water's continuity depth and fixed
-offset (``floodsph.sph.level_offsets``) but without the damping, a few particles in pockets
-of the nodata border still grew e-fold every 11 s: a one-sided support whose particle moves
-away from its neighbours expands, its level falls and the level difference pushes it further.
-The damping's rate, 0.5 s-1, is five times that growth, and it acts only below 1 cm/s and
-within 1 cm of the seeded level, where a lake is at rest.
+Held water is also damped and tethered: at each drift v_i <- (v_i - k (x_i - x_i^seed) dt)
+exp(-dt / ``HOLD_TIME``), k = ``HOLD_STIFFNESS``, x_i^seed where it was at set-up. Measured on
+the Malpasset reservoir disturbed by 1e-6 m/s, with the bank ghost and the held water's
+continuity depth and fixed offset (``floodsph.sph.level_offsets``) but neither of these, a few
+particles in pockets of the nodata border grew e-fold every 11 s (global steps): a one-sided
+support whose particle moves away from its neighbours expands, its level falls and the level
+difference pushes it further. With the damping alone one of them still crept away, its force
+growing with its displacement (a negative stiffness of about 0.025 s-2), and was released
+after 8 minutes. The tether's stiffness is four times that, and its period with the damping
+(20 s) is long against a step. Both act only below 1 cm/s and within 1 cm of the seeded
+level, where a lake is at rest.
 
 The ghost's depth: d* = eta_i - b_g where the bed beyond is level or falls (b_g <= b_i), else
 the hydrostatic reconstruction min(max(eta_i + run-up - b_g, 0), d_i) (Audusse et al. 2004,
@@ -111,9 +115,12 @@ COVER_MIN = 0.6
 """Shepard sum at x_g [-] at and above which there is water there (no ghost)."""
 BLEND_SPEED = 0.1
 """Speed [m s-1] from which water takes the variational force alone (:func:`variational_weight`)."""
-HOLD_TIME = 2.0
-"""Relaxation time [s] of the linear damping a = -v / HOLD_TIME of still water held by its
-banks (module docstring)."""
+HOLD_TIME = 1.0
+"""Relaxation time [s] of the damping of still water held by its banks (module docstring;
+``floodsph.sph.level_offsets.hold_still``)."""
+HOLD_STIFFNESS = 0.1
+"""Stiffness [s-2] of the tether of still water held by its banks to where it was seeded
+(module docstring; ``floodsph.sph.level_offsets.hold_still``)."""
 HOLD_LEVEL = 0.01
 """Departure [m] of a held particle's level from its seeded level at which it is released
 (module docstring)."""
@@ -352,9 +359,6 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         ixx, ixy, iyy = _inverse(nxx, nxy, nyy)
         ax[i] = acc[0] - GRAVITY * (ixx * sx + ixy * sy)
         ay[i] = acc[1] - GRAVITY * (ixy * sx + iyy * sy)
-        if bank_held[i] == HELD:
-            ax[i] -= u[i] / HOLD_TIME
-            ay[i] -= v[i] / HOLD_TIME
         beta = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
         divv[i] = -beta * acc[9] / rho[i]
 

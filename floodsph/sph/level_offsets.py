@@ -24,7 +24,8 @@ set-up, ``floodsph.sph.level_momentum``):
 
 * its depth follows continuity alone, d <- d (1 - dt div v) (the density solve leaves it),
   so that it rises under compression and falls under expansion;
-* its offset does not fade.
+* its offset does not fade;
+* its velocity is damped, and it is tethered to where it was seeded (:func:`hold_still`).
 
 When it is released (``RELEASED``), the density solve takes it again, and its offset takes
 the difference between its continuity depth and its summation depth, so that its level does
@@ -68,6 +69,19 @@ def decay_offsets(u, v, h, dt, bank_held, offset):
     for i in prange(offset.shape[0]):
         if offset[i] != 0.0 and bank_held[i] != HELD:
             offset[i] *= math.exp(-math.sqrt(u[i] * u[i] + v[i] * v[i]) * dt / h[i])
+
+
+@njit(parallel=True, cache=True)
+def hold_still(u, v, x, y, x_seed, y_seed, bank_held, dt, hold_time, stiffness):
+    """The ``HELD`` particles' velocities [m s-1] over a step dt [s]: tethered to where they were
+    at set-up (x_seed, y_seed) [m] by a spring of ``stiffness`` [s-2] and damped over
+    ``hold_time`` [s], v <- (v - stiffness (x - x_seed) dt) exp(-dt / hold_time)
+    (``floodsph.sph.level_momentum``, still water held by its banks)."""
+    factor = math.exp(-dt / hold_time)
+    for i in prange(u.shape[0]):
+        if bank_held[i] == HELD:
+            u[i] = (u[i] - stiffness * (x[i] - x_seed[i]) * dt) * factor
+            v[i] = (v[i] - stiffness * (y[i] - y_seed[i]) * dt) * factor
 
 
 def release(bank_held: np.ndarray, rho_continuity: np.ndarray, rho: np.ndarray,
