@@ -487,8 +487,8 @@ class FloodModel:
         level_momentum.balanced_acceleration(rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                              self.eta, self.bed, self.nl.start, self.nl.nbr,
                                              self.blocked, self.wall_lists(), t.elevation,
-                                             self.held, p.bank_held, p.eta_seed, t.dx, t.dy,
-                                             p.ax, p.ay, p.divv, self.ghost)
+                                             self.held, p.bank_held, t.dx, t.dy, p.ax, p.ay,
+                                             p.divv, self.ghost)
         forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
                                     p.ay, 0.0, -GRAVITY)
 

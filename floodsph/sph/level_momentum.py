@@ -48,14 +48,18 @@ free edge at set-up therefore keeps none while it stays slower than ``EDGE_SPEED
 ``floodsph.model.flood_model.FloodModel.match_levels`` and released for good once the
 particle reaches that speed, or its level departs from its seeded level by ``HOLD_LEVEL``):
 its banks were tested once, on the seeded lake. Where its support is cut (|e_i| h_i >=
-``EDGE_MIN``), the missing part is a bank standing at the lake's level: a ghost of level
-L_i, the seeded level, adds (L_i - eta_i) e_i to S_i and completes N_i as the dry ghost does.
-It is zero at rest, and pushes a particle whose level fell back among its neighbours.
+``EDGE_MIN``), the missing part is a bank that holds water as a wall does: the level is
+continued across it (no term in S_i; N_i is completed as for the dry ghost), and it stands
+still, so that a particle moving into it is compressed: its pairs with the missing part add
+sum_missing m_j F_ij (v_i . r_ij) ~ rho_i (v_i . e_i) to the divergence sum. A ghost at the
+lake's seeded level instead left a particle whose level fell free to creep into the gap, and
+Malpasset's reservoir disturbed by 1e-4 m/s left rest after 450 s (with it, 600 s pass).
 
 Held water is also damped and tethered: at each drift v_i <- (v_i - k (x_i - x_i^seed) dt)
 exp(-dt / ``HOLD_TIME``), k = ``HOLD_STIFFNESS``, x_i^seed where it was at set-up. Measured on
-the Malpasset reservoir disturbed by 1e-6 m/s, with the bank ghost and the held water's
-continuity depth and fixed offset (``floodsph.sph.level_offsets``) but neither of these, a few
+the Malpasset reservoir disturbed by 1e-6 m/s, with a bank ghost at the lake's level and the
+held water's continuity depth and fixed offset (``floodsph.sph.level_offsets``) but neither
+of these, a few
 particles in pockets of the nodata border grew e-fold every 11 s (global steps): a one-sided
 support whose particle moves away from its neighbours expands, its level falls and the level
 difference pushes it further. With the damping alone one of them still crept away, its force
@@ -276,16 +280,14 @@ def ghost_depth(i, ex, ey, hi, xi, yi, u, v, eta, bed, nstart, nbr, blocked, x, 
 
 @njit(parallel=True, cache=True)
 def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, nbr, blocked,
-                          walls, elevation, held, bank_held, eta_seed, tdx, tdy, ax, ay, divv,
-                          ghost):
+                          walls, elevation, held, bank_held, tdx, tdy, ax, ay, divv, ghost):
     """a_i = -g N_i^-1 S_i + shock capturing, and div v_i, of the particles ``rows`` (gather
     form; module docstring), with the neighbour lists, blocked pairs and
     :class:`~floodsph.walls.index.WallLists` of ``floodsph.sph.forces.internal_acceleration``;
     ``eta`` [m] the particles' levels, ``bed`` their bed sample (``floodsph.sph.bed``),
     ``elevation`` the terrain's node grid of spacing (tdx, tdy) [m] and ``held`` its cells
     that held water at seeding or are nodata (test 3), ``bank_held`` the particles' flags of
-    still water held by its banks and ``eta_seed`` [m] their seeded levels (module
-    docstring); ``ghost`` receives each
+    still water held by its banks (module docstring); ``ghost`` receives each
     particle's ghost depth d* [m] (0: no free edge)."""
     seg, wdist, wstart, wseg, cstart, cpair = walls
     for k in prange(rows.shape[0]):
@@ -333,13 +335,13 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         sy = acc[3]
         ex = -acc[7]
         ey = -acc[8]
+        bank_div = 0.0
         if bank_held[i] == HELD:
             d_ghost = 0.0
             e = math.sqrt(ex * ex + ey * ey)
-            if e * hi >= EDGE_MIN:  # the bank: a ghost at the lake's level
+            if e * hi >= EDGE_MIN:  # the bank: a wall
                 reach = GHOST_REACH * hi
-                sx += (eta_seed[i] - eta[i]) * ex
-                sy += (eta_seed[i] - eta[i]) * ey
+                bank_div = rho[i] * (u[i] * ex + v[i] * ey)
                 nxx += reach * ex * ex / e
                 nxy += reach * ex * ey / e
                 nyy += reach * ey * ey / e
@@ -360,7 +362,7 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         ax[i] = acc[0] - GRAVITY * (ixx * sx + ixy * sy)
         ay[i] = acc[1] - GRAVITY * (ixy * sx + iyy * sy)
         beta = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
-        divv[i] = -beta * acc[9] / rho[i]
+        divv[i] = -beta * (acc[9] + bank_div) / rho[i]
 
 
 
