@@ -45,7 +45,8 @@ from floodsph.sph.neighbours import NeighbourList
 from floodsph.sph.sums import SUMS
 from floodsph.sph.velocity_gradient import velocity_gradient
 from floodsph.walls import sight
-from floodsph.walls.index import WallIndex, WallLists
+from floodsph.walls.index import MapWalls, WallIndex, WallLists
+from floodsph.walls.sight import SIGHT_SLACK
 
 MAX_SEARCH_GROWTH = 2.0
 """Cap on the factor ``hgrow`` by which a particle's neighbour search is widened."""
@@ -269,6 +270,15 @@ class FloodModel:
         boundary): the neighbour and near-wall lists are stale, and the next step rebuilds
         them."""
         self.nl = None
+
+    def map_walls(self) -> MapWalls:
+        """The walls as the maps see them (``floodsph.output.rasterise``): each particle's
+        segments within its support 2 h_i (and the sight test's slack)."""
+        p = self.particles
+        near = self.wall_index.near_lists(p.x, p.y, p.h + SIGHT_SLACK,
+                                          np.zeros(p.n + 1, dtype=np.int64),
+                                          np.zeros(0, dtype=np.int64), 2.0)
+        return MapWalls(self.seg, near.wstart, near.wseg)
 
     def protected(self, x, y, h) -> np.ndarray:
         """True for points (x, y) [m] with a wall segment within the kernel reach of h [m]

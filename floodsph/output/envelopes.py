@@ -117,13 +117,16 @@ class Envelopes:
             self._maps[name] = np.zeros(grid.shape, dtype=np.uint8)
         self._bed = np.ascontiguousarray(grid.bed, dtype=np.float64)
 
-    def update(self, t, dt_since_last, x, y, u, v, m, rho, h, level=None) -> None:
+    def update(self, t, dt_since_last, x, y, u, v, m, rho, h, level=None,
+               walls=None) -> None:
         """Rasterise the particles at time t [s] and fold the state into every map.
 
         ``dt_since_last`` [s] is added to the duration of the cells wet now; ``level``: the
-        particles' free-surface levels, mapped less the bed (``rasterise``).
+        particles' free-surface levels, mapped less the bed; ``walls``: the walls that hide
+        cells from particles (``rasterise``).
         """
-        d, uu, vv, _ = rasterise(self.grid, x, y, u, v, m, rho, h, self.min_support, level)
+        d, uu, vv, _ = rasterise(self.grid, x, y, u, v, m, rho, h, self.min_support, level,
+                                 walls)
         self.fold(t, dt_since_last, d, uu, vv)
 
     def fold(self, t, dt_since_last, d, u, v) -> None:
@@ -142,7 +145,8 @@ class Envelopes:
         schedule (``floodsph.simulation.recorders``) decides when."""
         p = model.particles
         dt = 0.0 if self.t_last is None else model.t - self.t_last
-        self.update(model.t, dt, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, model.surface_levels())
+        self.update(model.t, dt, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, model.surface_levels(),
+                    model.map_walls())
 
     def maps(self) -> dict[str, np.ndarray]:
         """Copies of the maps by name (row 0 = south); float64 or uint8 for classes."""

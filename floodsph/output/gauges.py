@@ -105,14 +105,15 @@ class Gauges:
         self.t_last: float | None = None
         self.rows: list[tuple] = []
 
-    def sample(self, t, x, y, u, v, m, rho, h, level=None) -> None:
+    def sample(self, t, x, y, u, v, m, rho, h, level=None, walls=None) -> None:
         """Interpolate the particles at the gauges at time t [s] and store one row each;
-        ``level``: the particles' free-surface levels (``rasterise.interpolate``)."""
+        ``level``: the particles' free-surface levels, ``walls`` the walls that hide gauges
+        from particles (``rasterise.interpolate``)."""
         from floodsph.output.rasterise import interpolate
 
         p = self.points
         d, gu, gv, _ = interpolate(p.x, p.y, x, y, u, v, m, rho, h, self.min_support, level,
-                                   p.bed)
+                                   p.bed, walls)
         for k, gid in enumerate(p.ids):
             if d[k] > self.wet_threshold:
                 row = (float(t), gid, d[k], d[k] + p.bed[k], math.hypot(gu[k], gv[k]))
@@ -125,7 +126,8 @@ class Gauges:
         """Sample a FloodModel (``model.t``, ``model.particles``); the simulation's schedule
         (``floodsph.simulation.recorders``) decides when."""
         q = model.particles
-        self.sample(model.t, q.x, q.y, q.u, q.v, q.m, q.rho, q.h, model.surface_levels())
+        self.sample(model.t, q.x, q.y, q.u, q.v, q.m, q.rho, q.h, model.surface_levels(),
+                    model.map_walls())
 
     def write_csv(self, path) -> Path:
         """Write ``time_s, id, depth_m, level_m, speed_ms`` (mm / ms precision; ``nan`` = dry),

@@ -32,6 +32,11 @@ class OutputGrid:
         Projected CRS of the DEM as WKT (None for synthetic terrain).
     bed : (ny, nx) float64 array
         Bed elevation b [m] at the cell centres, row 0 = south.
+    valid : (ny, nx) bool array or None
+        The cells whose centre lies in a DEM cell with data; the maps hold no water in the
+        others (None: every cell). Where a walled nodata border cuts across nodata cells,
+        the water reaches into them (``floodsph.walls.nodata``), but a map cell there has no
+        ground to hold a depth over.
     """
 
     nx: int
@@ -42,6 +47,7 @@ class OutputGrid:
     y0: float
     crs_wkt: str | None
     bed: np.ndarray | None
+    valid: np.ndarray | None = None
 
     @classmethod
     def from_terrain(cls, terrain, resolution_m: float | None = None) -> OutputGrid:
@@ -49,12 +55,14 @@ class OutputGrid:
 
         A resampled grid covers the whole DEM (its last row/column may overhang the DEM's
         north/east edge by less than one cell). Its bed is the bilinear interpolation of
-        the DEM nodes at the new cell centres (clamped at the border).
+        the DEM nodes at the new cell centres (clamped at the border); a cell is valid where
+        its centre lies in a DEM cell with data.
         """
         if resolution_m is None:
             ny, nx = terrain.shape
             return cls(nx, ny, float(terrain.dx), float(terrain.dy), float(terrain.x0),
-                       float(terrain.y0), terrain.crs_wkt, terrain.elevation.copy())
+                       float(terrain.y0), terrain.crs_wkt, terrain.elevation.copy(),
+                       terrain.valid.copy())
         if not (resolution_m > 0 and math.isfinite(resolution_m)):
             raise InputError(f"output.resolution_m must be a positive number of metres, "
                              f"got {resolution_m!r}")
@@ -63,8 +71,11 @@ class OutputGrid:
         ny = max(1, math.ceil(terrain.height / r - 1e-9))
         xc = (np.arange(nx) + 0.5) * r
         yc = (np.arange(ny) + 0.5) * r
-        bed = bilinear(terrain.elevation, terrain.dx, terrain.dy, *np.meshgrid(xc, yc))
-        return cls(nx, ny, r, r, float(terrain.x0), float(terrain.y0), terrain.crs_wkt, bed)
+        X, Y = np.meshgrid(xc, yc)
+        bed = bilinear(terrain.elevation, terrain.dx, terrain.dy, X, Y)
+        valid = terrain.covers(X.ravel(), Y.ravel(), valid_only=True).reshape(X.shape)
+        return cls(nx, ny, r, r, float(terrain.x0), float(terrain.y0), terrain.crs_wkt, bed,
+                   valid)
 
     @property
     def shape(self) -> tuple[int, int]:

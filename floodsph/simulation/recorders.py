@@ -90,7 +90,7 @@ class Recorders:
 
         p = sim.model.particles
         d, u, v, _ = rasterise(self.grid, p.x, p.y, p.u, p.v, p.m, p.rho, p.h,
-                               level=sim.model.surface_levels())
+                               level=sim.model.surface_levels(), walls=sim.model.map_walls())
         self.snapshots.append(sim.model.t, d, u, v)
 
     def write(self, into: Path) -> list[Path]:

@@ -24,6 +24,15 @@ NEAR_BUCKETS = 2.0
 bucket's precomputed candidates (:func:`_near_scan`); larger radii walk the bucket pyramid."""
 
 
+class MapWalls(NamedTuple):
+    """The walls as the maps see them (``floodsph.output.rasterise``): segments ``seg`` ((k, 4)
+    x0, y0, x1, y1 [m]) and each particle's near segments, ``wseg[wstart[j]:wstart[j + 1]]``."""
+
+    seg: np.ndarray
+    wstart: np.ndarray
+    wseg: np.ndarray
+
+
 class NearWalls(NamedTuple):
     """CSR lists of each particle's near wall segments and of its wall corners.
 

@@ -130,3 +130,42 @@ def test_map_grid_sums_equal_a_brute_force_sum_over_every_cell():
     np.testing.assert_allclose(vv.ravel()[reached], (w @ v)[reached] / s[reached], rtol=1e-9,
                                atol=1e-12)
     assert np.all(np.isnan(d.ravel()[~reached]))
+
+
+def test_a_wall_hides_the_water_behind_it_from_the_maps_and_gauges():
+    """Water up to a wall at x = 40 m, mapped down to a kernel sum of 0.2: with the wall's
+    segments no cell or gauge beyond it is wet, and the depth in front of it is the water's;
+    without them the kernel reaches past the wall."""
+    from floodsph.walls.index import MapWalls
+
+    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, 100), (0, 80), 2.0)
+    grid = OutputGrid.from_terrain(terrain)
+    p = lattice(10.0, 40.0, 10.0, 70.0, 2.0, 1.5)
+    seg = np.array([[40.0, 0.0, 40.0, 80.0]])
+    n = p["x"].size
+    walls = MapWalls(seg, np.arange(n + 1, dtype=np.int64), np.zeros(n, dtype=np.int64))
+    X, Y = np.meshgrid(*grid.cell_centres())
+    beyond = (X > 40.0) & (Y > 20.0) & (Y < 60.0)
+    front = (X > 30.0) & (X < 40.0) & (Y > 20.0) & (Y < 60.0)
+    d_open = rasterise(grid, **p, min_support=0.2)[0]
+    d_walled = rasterise(grid, **p, min_support=0.2, walls=walls)[0]
+    assert np.isfinite(d_open[beyond]).sum() >= 20
+    assert not np.isfinite(d_walled[beyond]).any()
+    np.testing.assert_allclose(d_walled[front], d_open[front])
+    gx, gy = np.array([35.0, 42.0]), np.array([40.0, 40.0])
+    d_gauge = interpolate(gx, gy, **p, min_support=0.2, walls=walls)[0]
+    assert d_gauge[0] == pytest.approx(1.5, rel=1e-6) and np.isnan(d_gauge[1])
+
+
+def test_maps_hold_no_water_over_nodata():
+    """A DEM with a nodata block: the lattice reaching its edge maps no depth in its cells."""
+    terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0, 100), (0, 80), 2.0)
+    valid = np.ones(terrain.shape, dtype=bool)
+    valid[:, 25:] = False  # x >= 50 m
+    terrain = Terrain(terrain.elevation, terrain.dx, terrain.dy, valid=valid)
+    grid = OutputGrid.from_terrain(terrain)
+    d = rasterise(grid, **lattice(10.0, 52.0, 10.0, 70.0, 2.0, 1.5))[0]
+    assert np.isfinite(d[:, 24]).any() and not np.isfinite(d[:, 25:]).any()
+    coarse = OutputGrid.from_terrain(terrain, 5.0)
+    d = rasterise(coarse, **lattice(10.0, 52.0, 10.0, 70.0, 2.0, 1.5))[0]
+    assert not np.isfinite(d[:, 10:]).any()
