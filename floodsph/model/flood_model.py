@@ -406,7 +406,8 @@ class FloodModel:
         p = self.particles
         h_predicted = p.h.copy()
         rho_predicted = p.rho.copy() if self.balanced else None
-        held = p.bank_held == level_offsets.HELD if self.balanced else None
+        held = ((p.bank_held == level_offsets.HELD) | (p.bank_held == level_offsets.BANKED)
+                if self.balanced else None)
         for _ in range(SETTLE_ROUNDS if settle else 2):
             self.block_pairs()
             outcome = density.solve_density(
@@ -503,14 +504,17 @@ class FloodModel:
                                     p.ay, 0.0, -GRAVITY)
 
     def _release(self, rows: np.ndarray) -> None:
-        """Release the still water held by its banks among ``rows`` that moves at
-        ``EDGE_SPEED`` or whose level ``self.eta`` departs from its seeded level by
-        ``HOLD_LEVEL`` (``floodsph.sph.level_momentum``)."""
+        """Among ``rows``, bank the still water held by its banks whose level ``self.eta``
+        departs from its seeded level by ``HOLD_LEVEL``, and release the held or banked water
+        that moves at ``EDGE_SPEED`` (``floodsph.sph.level_momentum``,
+        ``floodsph.sph.level_offsets``)."""
         p = self.particles
-        held = rows[p.bank_held[rows] == level_offsets.HELD]
-        moved = ((p.u[held] ** 2 + p.v[held] ** 2 >= level_momentum.EDGE_SPEED ** 2)
-                 | (np.abs(self.eta[held] - p.eta_seed[held]) >= level_momentum.HOLD_LEVEL))
-        p.bank_held[held[moved]] = level_offsets.RELEASED
+        state = p.bank_held[rows]
+        fast = p.u[rows] ** 2 + p.v[rows] ** 2 >= level_momentum.EDGE_SPEED ** 2
+        departed = np.abs(self.eta[rows] - p.eta_seed[rows]) >= level_momentum.HOLD_LEVEL
+        p.bank_held[rows[(state == level_offsets.HELD) & departed]] = level_offsets.BANKED
+        kept = (state == level_offsets.HELD) | (state == level_offsets.BANKED)
+        p.bank_held[rows[kept & fast]] = level_offsets.RELEASED
 
     def match_levels(self) -> int:
         """Give every particle seeded at rest the level offset that makes its level its seeded

@@ -46,8 +46,9 @@ particle's ghost switched on in the first step). Water seeded at rest whose supp
 free edge at set-up therefore keeps none while it stays slower than ``EDGE_SPEED``
 (``bank_held`` = ``floodsph.sph.level_offsets.HELD``, set by
 ``floodsph.model.flood_model.FloodModel.match_levels`` and released for good once the
-particle reaches that speed, or its level departs from its seeded level by ``HOLD_LEVEL``):
-its banks were tested once, on the seeded lake. Where its support is cut (|e_i| h_i >=
+particle reaches that speed; a departure of its level from its seeded level by
+``HOLD_LEVEL`` ends the rest of the hold, ``floodsph.sph.level_offsets.BANKED``): its banks
+were tested once, on the seeded lake. Where its support is cut (|e_i| h_i >=
 ``EDGE_MIN``), the missing part is a bank that holds water as a wall does: the level is
 continued across it (no term in S_i; N_i is completed as for the dry ghost), and it stands
 still, so that a particle moving into it is compressed: its pairs with the missing part add
@@ -100,7 +101,7 @@ from numba import njit, prange
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.bed import BED, elevation_at
 from floodsph.sph.kernels import dwdr_over_r_cubic, w_cubic
-from floodsph.sph.level_offsets import HELD
+from floodsph.sph.level_offsets import FREE
 from floodsph.walls.geometry import mirror
 from floodsph.walls.images import moving_image
 from floodsph.walls.sight import SIGHT_SLACK, hides
@@ -336,7 +337,7 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         ex = -acc[7]
         ey = -acc[8]
         bank_div = 0.0
-        if bank_held[i] == HELD:
+        if bank_held[i] != FREE:  # held, banked or just released: no free edge
             d_ghost = 0.0
             e = math.sqrt(ex * ex + ey * ey)
             if e * hi >= EDGE_MIN:  # the bank: a wall

@@ -27,9 +27,13 @@ set-up, ``floodsph.sph.level_momentum``):
 * its offset does not fade;
 * its velocity is damped, and it is tethered to where it was seeded (:func:`hold_still`).
 
-When it is released (``RELEASED``), the density solve takes it again, and its offset takes
-the difference between its continuity depth and its summation depth, so that its level does
-not jump (:func:`release`); from then on the offset fades as for any moving water.
+When its level departs from its seeded level it is ``BANKED``: no longer damped or tethered,
+it keeps the rest. When it moves (``RELEASED``), the density solve takes it again, and its
+offset takes the difference between its continuity depth and its summation depth, so that
+its level does not jump (:func:`release`); from then on the offset fades as for any moving
+water. (Released to the summation depth by a change of level alone, a particle pressed
+against Malpasset's dam wall, whose summation depth is 54 m where the water is 35 m deep,
+jumped between the solve's roots and was thrown at 10 m/s.)
 """
 
 from __future__ import annotations
@@ -46,6 +50,11 @@ FREE = 0
 """``bank_held`` of water that is not held by its banks (moving, or with a free edge)."""
 HELD = 1
 """``bank_held`` of still water held by its banks (module docstring)."""
+BANKED = 2
+"""``bank_held`` of water released from ``HELD`` by a change of its level but still slower
+than ``floodsph.sph.level_momentum.EDGE_SPEED``: it keeps its continuity depth and offset,
+and its banks are not tested again, but it is no longer damped or tethered (module
+docstring)."""
 RELEASED = -1
 """``bank_held`` of water that left ``HELD`` in the last force evaluation, whose offset the
 next density solve matches (:func:`release`)."""
@@ -64,10 +73,10 @@ def levels(x, y, rho, offset, elevation, tdx, tdy, eta):
 @njit(parallel=True, cache=True)
 def decay_offsets(u, v, h, dt, bank_held, offset):
     """o_i <- o_i exp(-|v_i| dt / h_i): the offset fades over the distance travelled, in units of
-    the smoothing length, except for the ``HELD`` particles of ``bank_held`` (module
-    docstring)."""
+    the smoothing length, except for the ``HELD`` and ``BANKED`` particles of ``bank_held``
+    (module docstring)."""
     for i in prange(offset.shape[0]):
-        if offset[i] != 0.0 and bank_held[i] != HELD:
+        if offset[i] != 0.0 and bank_held[i] != HELD and bank_held[i] != BANKED:
             offset[i] *= math.exp(-math.sqrt(u[i] * u[i] + v[i] * v[i]) * dt / h[i])
 
 
