@@ -92,6 +92,12 @@ class FloodModel:
     """
 
     stage_timer = None  # a class default, so that models pickled before it existed load
+    flux_lines = None
+    """``floodsph.simulation.flux.FluxLines`` counting the water that crosses the scenario's
+    flux lines (every move of a particle: :meth:`count_moves`), or None."""
+    volume_out_other = 0.0
+    """Outflow [m3] off the grid or into nodata cells that no open side or sink took
+    (:meth:`remove_outside`)."""
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
                  seg: np.ndarray, closed_edges: bool | tuple[str, ...], boundaries,
@@ -221,8 +227,11 @@ class FloodModel:
         p = self.particles
         if self.balanced:
             level_offsets.decay_offsets(p.u, p.v, p.h, dt, p.eta_offset)
+        moves = None if self.flux_lines is None else (p.x.copy(), p.y.copy())
         self.counters["wall_reflections"] += int(sight.drift(
             p.x, p.y, p.u, p.v, dt, self.walls_near.wstart, self.walls_near.wseg, self.seg))
+        if moves is not None:
+            self.count_moves(*moves, p.x, p.y, p.m)
         self._nl_here = False
         self._lap("kick_drift")
         for boundary in self.boundaries:
@@ -231,6 +240,12 @@ class FloodModel:
         self._lap("boundaries")
         density.predict(p.rho, p.h, p.divv, dt)
         self._lap("density")
+
+    def count_moves(self, x0, y0, x1, y1, m) -> None:
+        """Water of mass ``m`` [kg] moved from (x0, y0) to (x1, y1) [m]: the flux lines count
+        what crossed them (``floodsph.simulation.flux``; nothing without flux lines)."""
+        if self.flux_lines is not None:
+            self.flux_lines.count(x0, y0, x1, y1, m)
 
     def synchronise(self, steps_taken: int = 1) -> None:
         """Refinement, and the periodic re-sort, on synchronised particles; ``steps_taken``
@@ -310,7 +325,9 @@ class FloodModel:
         p = self.particles
         inside = self.terrain.covers(p.x, p.y, valid_only=nodata)
         if not inside.all():
-            self.volume_out += float(p.m[~inside].sum() / RHO_WATER)
+            volume = float(p.m[~inside].sum() / RHO_WATER)
+            self.volume_out += volume
+            self.volume_out_other += volume
             p.keep(inside)
 
     def _reorder(self) -> None:

@@ -33,6 +33,7 @@ LOG_NAME = "floodsph.log"
 RESOLVED_NAME = "scenario.resolved.toml"
 MASS_BALANCE_NAME = "mass_balance.csv"
 GAUGES_NAME = "gauges.csv"
+FLUX_NAME = "flux.csv"
 SNAPSHOTS_NAME = "snapshots.nc"
 CHECKPOINT_DIR = "checkpoint"
 STAGING_DIR = ".floodsph-new"
@@ -58,7 +59,7 @@ SERIES_PICTURE_NAMES = ("gauges.png", "mass_balance.png")
 REPORT_NAME = "report.html"
 #: Every file name a run writes (scenario-format.md, "Run folder"); a run's files in progress
 #: carry one of these names with a suffix (``snapshots.nc.part``, ``max_depth.tif.part``).
-RUN_FILES = (*MAP_NAMES, SNAPSHOTS_NAME, GAUGES_NAME, MASS_BALANCE_NAME, MANIFEST_NAME,
+RUN_FILES = (*MAP_NAMES, SNAPSHOTS_NAME, GAUGES_NAME, FLUX_NAME, MASS_BALANCE_NAME, MANIFEST_NAME,
              RESOLVED_NAME, LOG_NAME, *PICTURE_NAMES, *SERIES_PICTURE_NAMES, REPORT_NAME)
 BREACH_GLOB = "breach_hydrograph_*.csv"
 #: Statuses of a run whose maps are written: its folder is only replaced on request.
