@@ -32,6 +32,7 @@ from datetime import datetime, timedelta
 from pathlib import Path
 
 import numpy as np
+from numba import njit
 
 from floodsph.constants import RHO_WATER
 
@@ -62,8 +63,6 @@ class FluxLines:
                     owner.append(index)
         self.seg = np.asarray(seg, dtype=np.float64).reshape(-1, 4)
         self.owner = np.asarray(owner, dtype=np.int64)
-        ends = np.concatenate([self.seg[:, :2], self.seg[:, 2:]]) if len(seg) else np.zeros((1, 2))
-        self.box = (*ends.min(axis=0), *ends.max(axis=0))
         n = len(self.names)
         self.since_row = np.zeros(n)  # net volume since the last row [m3]
         self.forward = np.zeros(n)  # left -> right over the run [m3]
@@ -75,51 +74,15 @@ class FluxLines:
         return f"FluxLines({', '.join(self.names)}; {self.seg.shape[0]} segments)"
 
     # -- counting ----------------------------------------------------------------------------
-    def crossings(self, x0, y0, x1, y1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The moves (x0, y0) -> (x1, y1) that cross a segment: (move index, line index,
-        sign), one entry per crossing; sign +1 from left to right of the segment, -1 back."""
-        xmin, ymin, xmax, ymax = self.box
-        near = ((np.minimum(x0, x1) <= xmax) & (np.maximum(x0, x1) >= xmin)
-                & (np.minimum(y0, y1) <= ymax) & (np.maximum(y0, y1) >= ymin))
-        moves = np.flatnonzero(near)
-        found_i, found_line, found_sign = [], [], []
-        if moves.size:
-            px0, py0, px1, py1 = x0[moves], y0[moves], x1[moves], y1[moves]
-            for k, (ax, ay, bx, by) in enumerate(self.seg):
-                dx, dy = bx - ax, by - ay
-                s0 = dx * (py0 - ay) - dy * (px0 - ax)  # > 0: left of A -> B
-                s1 = dx * (py1 - ay) - dy * (px1 - ax)
-                left0, left1 = s0 > 0.0, s1 > 0.0
-                hit = np.flatnonzero(left0 != left1)
-                if hit.size == 0:
-                    continue
-                f = s0[hit] / (s0[hit] - s1[hit])  # where the move meets the segment's line
-                qx = px0[hit] + f * (px1[hit] - px0[hit])
-                qy = py0[hit] + f * (py1[hit] - py0[hit])
-                w = ((qx - ax) * dx + (qy - ay) * dy) / (dx * dx + dy * dy)
-                on = (w >= 0.0) & (w < 1.0)
-                hit = hit[on]
-                found_i.append(moves[hit])
-                found_line.append(np.full(hit.size, self.owner[k]))
-                found_sign.append(np.where(left0[hit], 1.0, -1.0))
-        if not found_i:
-            empty = np.zeros(0, dtype=np.int64)
-            return empty, empty, np.zeros(0)
-        return np.concatenate(found_i), np.concatenate(found_line), np.concatenate(found_sign)
-
     def count(self, x0, y0, x1, y1, m) -> None:
         """Add the volume m / rho_w [m3] of each move (x0, y0) -> (x1, y1) [m] that crosses a
         line, with its sign (module docstring)."""
         if self.seg.shape[0] == 0 or len(x0) == 0:
             return
-        i, line, sign = self.crossings(np.asarray(x0), np.asarray(y0), np.asarray(x1),
-                                       np.asarray(y1))
-        if i.size == 0:
-            return
-        volume = np.asarray(m)[i] / RHO_WATER
         n = len(self.names)
-        forward = np.bincount(line[sign > 0], volume[sign > 0], minlength=n)
-        backward = np.bincount(line[sign < 0], volume[sign < 0], minlength=n)
+        forward, backward = np.zeros(n), np.zeros(n)
+        count_crossings(*(np.ascontiguousarray(a, dtype=np.float64) for a in (x0, y0, x1, y1, m)),
+                        self.seg, self.owner, forward, backward)
         self.forward += forward
         self.backward += backward
         self.since_row += forward - backward
@@ -161,3 +124,34 @@ class FluxLines:
         return [{"name": name, "volume_net_m3": float(f - b),
                  "volume_left_to_right_m3": float(f), "volume_right_to_left_m3": float(b)}
                 for name, f, b in zip(self.names, self.forward, self.backward, strict=True)]
+
+
+@njit(cache=True)
+def count_crossings(x0, y0, x1, y1, m, seg, owner, forward, backward):
+    """Add m / rho_w of each move (x0, y0) -> (x1, y1) that crosses a segment (x_a, y_a, x_b,
+    y_b) of ``seg`` to ``forward[owner]`` (from the left of a -> b to the right) or
+    ``backward[owner]`` (the other way). A move crosses where its ends lie strictly left and
+    not strictly left of the segment's line, at a point from a up to, not including, b."""
+    for i in range(x0.shape[0]):
+        px0, py0, px1, py1 = x0[i], y0[i], x1[i], y1[i]
+        for k in range(seg.shape[0]):
+            ax, ay, bx, by = seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3]
+            if (max(px0, px1) < min(ax, bx) or min(px0, px1) > max(ax, bx)
+                    or max(py0, py1) < min(ay, by) or min(py0, py1) > max(ay, by)):
+                continue
+            dx, dy = bx - ax, by - ay
+            s0 = dx * (py0 - ay) - dy * (px0 - ax)
+            s1 = dx * (py1 - ay) - dy * (px1 - ax)
+            left = s0 > 0.0
+            if left == (s1 > 0.0):
+                continue
+            f = s0 / (s0 - s1)
+            qx = px0 + f * (px1 - px0)
+            qy = py0 + f * (py1 - py0)
+            w = ((qx - ax) * dx + (qy - ay) * dy) / (dx * dx + dy * dy)
+            if w < 0.0 or w >= 1.0:
+                continue
+            if left:
+                forward[owner[k]] += m[i] / RHO_WATER
+            else:
+                backward[owner[k]] += m[i] / RHO_WATER
