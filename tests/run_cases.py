@@ -43,14 +43,31 @@ snapshot_interval_s = 5.0
 """
 
 
-def write_dam_break(folder, stepping: str = "global", end_time: float = 40.0):
+FLUX_LINES = f"""
+[[flux_lines]]
+name = "floor"
+polyline = [[{X0 + 250}, {Y0 - 10}], [{X0 + 260}, {Y0 + 100}], [{X0 + 250}, {Y0 + NY * CELL + 10}]]
+
+[[flux_lines]]
+name = "basin_edge"
+polyline = [[{X0 + 100}, {Y0 + NY * CELL}], [{X0 + 100}, {Y0}]]
+"""
+"""Two flux lines across the valley for :func:`write_dam_break` (``flux=True``)."""
+
+
+def write_dam_break(folder, stepping: str = "global", end_time: float = 40.0,
+                    flux: bool = False):
     """The scenario file of :data:`DAM_BREAK` with its hydrograph and gauges, beside the
-    valley DEM in ``folder``."""
+    valley DEM in ``folder``; ``flux``: with :data:`FLUX_LINES` and snapshots at two listed
+    times besides the interval's."""
     (folder / "q.csv").write_text("time_s,discharge_m3s\n0,0\n10,20\n30,20\n40,0\n")
     (folder / "gauges.csv").write_text(
         f"id,x,y\nbasin,{X0 + 50},{Y0 + 100}\nfloor,{X0 + 250},{Y0 + 100}\n")
     text = DAM_BREAK.replace("{stepping}", stepping).replace(
         "end_time_s = 40.0", f"end_time_s = {end_time}")
-    path = folder / f"{stepping}-{end_time:g}.toml"
+    if flux:
+        text = text.replace("\n[numerics]", FLUX_LINES + "\n[numerics]") + (
+            "snapshot_times_s = [7.3, 23.9]\n")
+    path = folder / f"{stepping}-{end_time:g}{'-flux' if flux else ''}.toml"
     path.write_text(text, encoding="utf-8")
     return path

@@ -156,8 +156,11 @@ class Inflow:
             nx, ny = self.normal
             w = p.u[back] * nx + p.v[back] * ny
             shift = -2.0 * s[back]
+            x0, y0 = p.x[back], p.y[back]
             p.x[back] += shift * nx
             p.y[back] += shift * ny
+            if getattr(model, "flux_lines", None) is not None:
+                model.count_moves(x0, y0, p.x[back], p.y[back], p.m[back])
             p.u[back] -= 2.0 * w * nx
             p.v[back] -= 2.0 * w * ny
 

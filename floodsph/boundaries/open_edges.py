@@ -103,6 +103,7 @@ class OpenEdges:
         self.buffer = {name: np.zeros(0) for name in _BUFFER_FIELDS}
         self.reach = 0.0
         self.volume_out = 0.0
+        self.volume_out_sides = dict.fromkeys(self.sides, 0.0)
         self._seeded = False
         self._ghosts = slice(0, 0)
 
@@ -132,16 +133,26 @@ class OpenEdges:
         b["x"] += b["u"] * dt
         b["y"] += b["v"] * dt
         if p.n and self.sides:
-            crossed = (self._beyond(p.x, p.y) > 0.0).any(axis=0)
+            beyond = self._beyond(p.x, p.y)
+            crossed = (beyond > 0.0).any(axis=0)
             if crossed.any():
                 volume = float(p.m[crossed].sum()) / RHO_WATER
                 self.volume_out += volume
                 model.volume_out += volume
+                self._count_sides(p.m[crossed], beyond[:, crossed])
                 self._take(p, crossed)
                 p.keep(~crossed)
         inside_reach = (self._beyond(b["x"], b["y"]) < self.reach).all(axis=0)
         for name in _BUFFER_FIELDS:
             b[name] = b[name][inside_reach]
+
+    def _count_sides(self, m, beyond) -> None:
+        """Add the volume m / rho_w [m3] of particles that left to the side each is furthest
+        beyond (``beyond``: their (k, n) distances past the open sides; a corner goes to one)."""
+        side = np.argmax(beyond, axis=0)
+        volume = np.bincount(side, m, minlength=len(self.sides)) / RHO_WATER
+        for name, v in zip(self.sides, volume, strict=True):
+            self.volume_out_sides[name] += float(v)
 
     def _update_reach(self, model) -> None:
         p = model.particles

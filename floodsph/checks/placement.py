@@ -98,7 +98,8 @@ def check_point_on_dem(terrain, point, where: str) -> None:
 
 
 def check_geometry_on_dem(scenario, terrain, spacing_m: float, source: str) -> None:
-    """Refuse polygons and walls wholly off the DEM, and inflow lines off it or too short.
+    """Refuse polygons, walls and flux lines wholly off the DEM, and inflow lines off it or
+    too short.
 
     A polygon must share a non-zero area with the DEM rectangle and a wall a non-zero length;
     a part outside is allowed (a reservoir outline drawn beyond a cropped DEM). Geometry read
@@ -120,6 +121,12 @@ def check_geometry_on_dem(scenario, terrain, spacing_m: float, source: str) -> N
             raise off_dem_error(f"{source}: {wall.feature or f'walls[{i}].polyline'}",
                                 "the wall lies wholly",
                                 wall.polyline, terrain)
+    for i, flux in enumerate(scenario.flux_lines):
+        line = shapely.LineString(flux.polyline)
+        if shapely.intersection(line, box).length <= 0.0:
+            raise off_dem_error(f"{source}: flux_lines[{i}].polyline",
+                                f"the flux line {flux.name!r} lies wholly", flux.polyline,
+                                terrain)
     for i, inflow in enumerate(scenario.inflows):
         where = f"{source}: inflows[{i}].line"
         for point in inflow.line:

@@ -64,11 +64,12 @@ class Inputs:
     """What a run starts from (all coordinates local to the terrain's origin).
 
     ``walls`` (polylines) and ``sinks`` (polygons) are (k, 2) arrays, inline ones and those
-    read from vector files alike. ``inflows`` are the scenario's ``[[inflows]]`` with their
-    line and direction in the terrain's CRS (``floodsph.io.coordinates``). ``warnings``
-    lists the inputs accepted with a warning (each also logged at WARNING); ``conversions``
-    the units the input files were converted from (hydrographs in hours or cubic feet per
-    second, dates), one sentence per file.
+    read from vector files alike; ``flux_lines`` are (name, (k, 2) polyline) pairs.
+    ``inflows`` are the scenario's ``[[inflows]]`` with their line and direction in the
+    terrain's CRS (``floodsph.io.coordinates``). ``warnings`` lists the inputs accepted
+    with a warning (each also logged at WARNING); ``conversions`` the units the input files
+    were converted from (hydrographs in hours or cubic feet per second, dates), one sentence
+    per file.
     """
 
     terrain: Terrain
@@ -86,6 +87,7 @@ class Inputs:
     memory: MemoryEstimate
     warnings: list[str] = field(default_factory=list)
     conversions: list[str] = field(default_factory=list)
+    flux_lines: list[tuple[str, np.ndarray]] = field(default_factory=list)
 
 
 def prepare_inputs(scenario: Scenario) -> Inputs:
@@ -163,6 +165,8 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         memory=memory,
         warnings=warnings,
         conversions=conversions,
+        flux_lines=[(line.name, local_points(terrain, line.polyline))
+                    for line in scenario.flux_lines],
     )
 
 

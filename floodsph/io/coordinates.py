@@ -126,5 +126,6 @@ def inline_to_model(scenario, terrain):
         initial_water=move(scenario.initial_water, "initial_water", "polygon"),
         walls=move(scenario.walls, "walls", "polyline"),
         sinks=move(scenario.sinks, "sinks", "polygon"),
+        flux_lines=move(scenario.flux_lines, "flux_lines", "polyline"),
         inflows=inflows,
     )

@@ -21,6 +21,8 @@ multiple of the finest step (``floodsph.sph.local_steps``).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from floodsph.constants import GRAVITY, RHO_WATER
@@ -47,6 +49,9 @@ from floodsph.sph.velocity_gradient import velocity_gradient
 from floodsph.walls import sight
 from floodsph.walls.index import MapWalls, WallIndex, WallLists
 from floodsph.walls.sight import SIGHT_SLACK
+
+if TYPE_CHECKING:
+    from floodsph.simulation.flux import FluxLines
 
 MAX_SEARCH_GROWTH = 2.0
 """Cap on the factor ``hgrow`` by which a particle's neighbour search is widened."""
@@ -96,6 +101,12 @@ class FloodModel:
     """
 
     stage_timer = None  # a class default, so that models pickled before it existed load
+    flux_lines: FluxLines | None = None
+    """``floodsph.simulation.flux.FluxLines`` counting the water that crosses the scenario's
+    flux lines (every move of a particle: :meth:`count_moves`), or None."""
+    volume_out_other = 0.0
+    """Outflow [m3] off the grid or into nodata cells that no open side or sink took
+    (:meth:`remove_outside`)."""
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
                  seg: np.ndarray, closed_sides: frozenset[str], boundaries,
@@ -229,8 +240,11 @@ class FloodModel:
             level_offsets.decay_offsets(p.u, p.v, p.h, dt, p.bank_held, p.eta_offset)
             level_offsets.hold_still(p.u, p.v, p.x, p.y, p.x_seed, p.y_seed, p.bank_held, dt,
                                      level_momentum.HOLD_TIME, level_momentum.HOLD_STIFFNESS)
+        moves = None if self.flux_lines is None else (p.x.copy(), p.y.copy())
         self.counters["wall_reflections"] += int(sight.drift(
             p.x, p.y, p.u, p.v, dt, self.walls_near.wstart, self.walls_near.wseg, self.seg))
+        if moves is not None:
+            self.count_moves(*moves, p.x, p.y, p.m)
         self._nl_here = False
         self._lap("kick_drift")
         for boundary in self.boundaries:
@@ -239,6 +253,12 @@ class FloodModel:
         self._lap("boundaries")
         density.predict(p.rho, p.h, p.divv, dt)
         self._lap("density")
+
+    def count_moves(self, x0, y0, x1, y1, m) -> None:
+        """Water of mass ``m`` [kg] moved from (x0, y0) to (x1, y1) [m]: the flux lines count
+        what crossed them (``floodsph.simulation.flux``; nothing without flux lines)."""
+        if self.flux_lines is not None:
+            self.flux_lines.count(x0, y0, x1, y1, m)
 
     def synchronise(self, steps_taken: int = 1) -> None:
         """Refinement, and the periodic re-sort, on synchronised particles; ``steps_taken``
@@ -327,7 +347,9 @@ class FloodModel:
         p = self.particles
         inside = self.terrain.covers(p.x, p.y, valid_only=nodata)
         if not inside.all():
-            self.volume_out += float(p.m[~inside].sum() / RHO_WATER)
+            volume = float(p.m[~inside].sum() / RHO_WATER)
+            self.volume_out += volume
+            self.volume_out_other += volume
             p.keep(inside)
 
     def _reorder(self) -> None:

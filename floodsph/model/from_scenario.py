@@ -23,10 +23,12 @@ def build_model(scenario: Scenario, inputs):
     """The FloodModel of ``scenario`` from prepared inputs, with its open boundaries.
 
     The model's numerics are the scenario's, with ``particle_spacing_m`` the spacing the
-    particles were seeded at (the DEM cell size when the scenario gives none).
+    particles were seeded at (the DEM cell size when the scenario gives none); the
+    ``[[flux_lines]]`` count the water crossing them from the first step
+    (``FloodModel.flux_lines``).
     """
     numerics = replace(scenario.numerics, particle_spacing_m=inputs.spacing_m)
-    return set_up_model(
+    model = set_up_model(
         inputs.terrain,
         inputs.particles,
         numerics,
@@ -36,6 +38,11 @@ def build_model(scenario: Scenario, inputs):
         refiner=Refiner.of(numerics),
         held=inputs.depth > 0.0,
     )
+    if inputs.flux_lines:
+        from floodsph.simulation.flux import FluxLines
+
+        model.flux_lines = FluxLines(inputs.flux_lines)
+    return model
 
 
 def _closed_sides(terrain) -> frozenset[str]:

@@ -150,6 +150,8 @@ class Refiner:
         parents, a, b = (np.asarray(i, dtype=np.int64) for i in (parents, a, b))
         born = self._split(model, parents)
         merged = self._merged(model, a, b)
+        if getattr(model, "flux_lines", None) is not None:
+            _count_refinement_moves(model, parents, a, b, born, merged)
         keep = np.ones(model.particles.n, dtype=bool)
         keep[parents] = False
         keep[a] = False
@@ -337,6 +339,21 @@ class Refiner:
                     h=h, h0=h, rho0=rho, alpha=2.0 * rho, **inherited,
                     level=np.minimum(p.level[a], p.level[b]), born=np.full(a.size, model.steps),
                     stride=np.minimum(p.stride[a], p.stride[b]))
+
+
+def _count_refinement_moves(model, parents, a, b, born, merged) -> None:
+    """Tell the model's flux lines where refinement moved water: each parent's mass to its
+    daughters (each with the daughter's mass), each pair's masses to the merged particle."""
+    from floodsph.sph import refine
+
+    p = model.particles
+    if born is not None:
+        rep = np.repeat(parents, refine.DAUGHTERS)
+        model.count_moves(p.x[rep], p.y[rep], born["x"], born["y"], born["m"])
+    if merged is not None:
+        both = np.concatenate([a, b])
+        model.count_moves(p.x[both], p.y[both], np.tile(merged["x"], 2),
+                          np.tile(merged["y"], 2), p.m[both])
 
 
 def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE,

@@ -69,6 +69,7 @@ STANDARD_NAMES = {
     "arrival_time": "time_when_flood_water_rises_above_threshold",
     "time_of_max_depth": "time_of_maximum_flood_depth",
     "depth": "flood_water_thickness",
+    "level": "water_surface_height_above_reference_datum",
 }
 """Variable -> CF standard name, where one fits exactly. ``duration`` (total wet time, not
 first-wet to last-dry), ``max_unit_discharge``, the hazard classes and the velocity
@@ -76,6 +77,8 @@ components along the projection axes (grid east/north, not true east/north) have
 
 COMMENTS = {
     "max_level": "reference datum: the vertical datum of the DEM (water level = depth + bed)",
+    "level": "reference datum: the vertical datum of the DEM (water level = depth + bed); "
+             "NaN where the depth is at or below the wet threshold",
     "duration": "sum of the intervals during which the cell was wet (depth above the wet "
                 "threshold)",
 }

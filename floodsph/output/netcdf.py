@@ -139,12 +139,14 @@ SNAPSHOT_VARIABLES = {
           "m s-1"),
     "v": ("depth-averaged velocity, component along the projection y axis (grid north)",
           "m s-1"),
+    "level": ("water-surface elevation (depth + bed), where wet", "m"),
 }
 """Snapshot variable -> (long name, units)."""
 
 
 class SnapshotWriter:
-    """Append depth and velocity maps at successive times to ``snapshots.nc`` (CF-1.8).
+    """Append depth, velocity and water-level maps at successive times to ``snapshots.nc``
+    (CF-1.8).
 
     The file has an unlimited ``time`` dimension (seconds since the start of the run,
     ``start``: :func:`floodsph.output.cf.time_attrs`) and the variables of
@@ -190,7 +192,7 @@ class SnapshotWriter:
         if previous is not None:
             with netCDF4.Dataset(previous) as src:
                 for k in range(keep_frames):
-                    for name in ("time", "depth", "u", "v"):
+                    for name in ("time", *SNAPSHOT_VARIABLES):
                         ds[name][k] = src[name][k]
             ds.sync()
             if source is None:
@@ -201,12 +203,15 @@ class SnapshotWriter:
         """Number of frames written."""
         return len(self._ds.dimensions["time"])
 
-    def append(self, t: float, d, u, v) -> None:
-        """Add the south-up maps d [m], u, v [m/s] at time t [s]."""
+    def append(self, t: float, d, u, v, level=None) -> None:
+        """Add the south-up maps d [m], u, v [m/s] and the water level [m] (NaN where dry;
+        None: all NaN) at time t [s]."""
         ds = self._ds
         k = len(ds.dimensions["time"])
         ds["time"][k] = float(t)
-        for name, arr in (("depth", d), ("u", u), ("v", v)):
+        if level is None:
+            level = np.full(np.shape(d), np.nan)
+        for name, arr in (("depth", d), ("u", u), ("v", v), ("level", level)):
             ds[name][k, :, :] = np.asarray(arr, dtype=np.float32)[::-1]
         ds.sync()
 

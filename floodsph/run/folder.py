@@ -31,6 +31,7 @@ from floodsph.io.atomic_files import TEMP_PREFIX
 from floodsph.io.run_names import (
     BREACH_GLOB,
     CHECKPOINT_DIR,
+    FLUX_NAME,
     GAUGES_NAME,
     LOCK_NAME,
     LOG_NAME,
@@ -50,8 +51,9 @@ if TYPE_CHECKING:
 
 #: Every file name a run writes (``docs/run-folder.md``); a run's files in progress
 #: carry one of these names with a suffix (``snapshots.nc.part``, ``max_depth.tif.part``).
-RUN_FILES = (*MAP_NAMES, SNAPSHOTS_NAME, GAUGES_NAME, MASS_BALANCE_NAME, MANIFEST_NAME,
-             RESOLVED_NAME, LOG_NAME, *PICTURE_NAMES, *SERIES_PICTURE_NAMES, REPORT_NAME)
+RUN_FILES = (*MAP_NAMES, SNAPSHOTS_NAME, GAUGES_NAME, FLUX_NAME, MASS_BALANCE_NAME,
+             MANIFEST_NAME, RESOLVED_NAME, LOG_NAME, *PICTURE_NAMES, *SERIES_PICTURE_NAMES,
+             REPORT_NAME)
 #: Statuses of a run whose maps are written: its folder is only replaced on request.
 FINISHED = ("completed", "stopped")
 

@@ -307,7 +307,8 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
                        None if checkpoint is None else checkpoint.mass_rows)
     bar = Progress(scenario.end_time_s, enabled=opts.progress)
     recorders = Recorders(scenario, inputs.terrain, inputs.gauges, work, state=state,
-                          snapshots_from=folder.finished_snapshots())
+                          snapshots_from=folder.finished_snapshots(),
+                          flux_lines=getattr(model, "flux_lines", None))
     callbacks = [
         (mass, TimeInterval(scenario.output.mass_balance_interval_s)),
         *recorders.callbacks(),
@@ -373,9 +374,31 @@ def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
         volume_in_m3=float(model.volume_in),
         volume_out_m3=float(model.volume_out),
         inflows=[_inflow_summary(b) for b in model.boundaries if isinstance(b, Inflow)],
+        **outflow_summary(model),
     )
+    if getattr(model, "flux_lines", None) is not None:
+        manifest["flux_lines"] = model.flux_lines.summary()
     if mass is not None:
         manifest["mass_error_rel"] = mass.budget(model).error_rel
+
+
+def outflow_summary(model) -> dict:
+    """``volume_out_m3`` by where the water left [m3]: ``volume_out_sinks_m3`` (one per sink,
+    in the order of ``[[sinks]]`` and the features of their files), ``volume_out_sides_m3``
+    (per open side of the DEM) and ``volume_out_other_m3`` (off the grid or into nodata
+    elsewhere); together they make ``volume_out_m3``."""
+    from floodsph.boundaries import Sink
+    from floodsph.boundaries.open_edges import OpenEdges
+
+    sides: dict[str, float] = {}
+    sinks = []
+    for boundary in getattr(model, "boundaries", ()):
+        if isinstance(boundary, OpenEdges):
+            sides.update(boundary.volume_out_sides)
+        elif isinstance(boundary, Sink):
+            sinks.append(float(boundary.volume_out))
+    return {"volume_out_sinks_m3": sinks, "volume_out_sides_m3": sides,
+            "volume_out_other_m3": float(getattr(model, "volume_out_other", 0.0))}
 
 
 def _inflow_summary(inflow) -> dict:

@@ -161,6 +161,16 @@ class Gauges:
 
 
 @dataclass(frozen=True)
+class FluxLine:
+    """``[[flux_lines]]``: a named polyline through which the discharge is measured
+    (``flux.csv``, ``floodsph.simulation.flux``). Water crossing it from the left of its
+    direction of travel (first point to last) to the right counts positive."""
+
+    name: str
+    polyline: tuple[Point, ...]
+
+
+@dataclass(frozen=True)
 class OutputConfig:
     """``[output]``: where and what to write. ``directory = None`` means ``out/<name>``.
 
@@ -168,6 +178,9 @@ class OutputConfig:
     at or after each multiple of it (``floodsph.simulation.checkpoint``); 0 writes none on a
     schedule
     (a stop signal still writes one).
+
+    ``snapshot_times_s`` [s]: increasing times within the run at which snapshots are written
+    as well (the time step lands on them), alone or with ``snapshot_interval_s``.
     """
 
     directory: Path | None = None
@@ -175,6 +188,7 @@ class OutputConfig:
     wet_threshold_m: float = 0.01
     formats: tuple[OutputFormat, ...] = (OutputFormat.GEOTIFF, OutputFormat.NETCDF)
     snapshot_interval_s: float = 0.0
+    snapshot_times_s: tuple[float, ...] = ()
     mass_balance_interval_s: float = 10.0
     checkpoint_interval_s: float = 0.0
 
@@ -191,6 +205,7 @@ class Scenario:
     inflows: tuple[Inflow, ...] = ()
     sinks: tuple[Sink, ...] = ()
     gauges: Gauges | None = None
+    flux_lines: tuple[FluxLine, ...] = ()
     numerics: Numerics = Numerics()
     output: OutputConfig = OutputConfig()
 
@@ -206,6 +221,14 @@ class Scenario:
     def start(self) -> datetime | None:
         """The calendar instant of t = 0 (``[scenario] start``, time zone aware), or None."""
         return self.scenario.start
+
+    @property
+    def flux_interval_s(self) -> float:
+        """Simulated time between rows of ``flux.csv`` [s]: the gauges' interval, else the
+        mass balance's."""
+        if self.gauges is not None:
+            return self.gauges.interval_s
+        return self.output.mass_balance_interval_s
 
     @property
     def output_directory(self) -> Path:
@@ -236,6 +259,8 @@ class Scenario:
         """
         out = {f.name: _plain(getattr(self, f.name)) for f in fields(self) if f.name != "path"}
         out["output"]["directory"] = str(self.output_directory)
+        if not out["output"].get("snapshot_times_s"):
+            out["output"].pop("snapshot_times_s", None)  # absent: as before the key existed
         return {k: v for k, v in out.items() if v is not None and v != []}
 
     def __repr__(self) -> str:
@@ -282,6 +307,7 @@ TOP_KEYS = (
     "inflows",
     "sinks",
     "gauges",
+    "flux_lines",
     "numerics",
     "output",
 )

@@ -25,6 +25,7 @@ from floodsph.breach.params import BreachParams
 from floodsph.scenario.config import (
     SIDES,
     Edges,
+    FluxLine,
     Gauges,
     Inflow,
     InitialWater,
@@ -281,6 +282,23 @@ GAUGES = TableDoc("gauges", False, "Time series of depth, level and speed at poi
            absent="the id attribute, else the feature number from 1"),
 ))
 
+FLUX_LINES = TableDoc("flux_lines", True, "Lines through which the discharge is measured, "
+                      "e.g. a section across the valley below a dam: the mean discharge over "
+                      "each interval goes to flux.csv (one column `<name>_m3s`, a row every "
+                      "gauges.interval_s, or every output.mass_balance_interval_s without "
+                      "gauges) and the volumes passed over the run to run.json "
+                      "(docs/outputs.md).", FluxLine, keys=(
+    KeyDoc("name", "string", "The line's name, unique among the flux lines (no commas, quotes "
+           "or control characters: it heads the column `<name>_m3s` of flux.csv).",
+           required=True),
+    KeyDoc("polyline", POINTS, "The line's vertices (at least two, non-zero length), in the "
+           "DEM file's CRS (or scenario.crs). Water crossing from the left of the direction "
+           "of travel (first point towards last) to the right counts positive: a line drawn "
+           "from the left bank to the right bank, looking downstream, measures the flow "
+           "downstream as positive. Draw it from bank to bank (or beyond the DEM) to catch "
+           "all the flow.", "m", required=True),
+))
+
 NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are the "
                     "recommended values; most scenarios set particle_spacing_m only.",
                     Numerics, keys=(
@@ -336,8 +354,13 @@ OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into i
     KeyDoc("wet_threshold_m", "number", "A cell is wet above this depth (arrival time, duration, "
            "extent).", "m"),
     KeyDoc("formats", "array of strings", "Map file formats to write.", choices=OutputFormat),
-    KeyDoc("snapshot_interval_s", "number", "> 0 writes depth and velocity maps every this much "
-           "simulated time to snapshots.nc; 0 writes none.", "s"),
+    KeyDoc("snapshot_interval_s", "number", "> 0 writes depth, velocity and water-level maps "
+           "every this much simulated time to snapshots.nc (and at the start and end); 0 "
+           "writes none.", "s"),
+    KeyDoc("snapshot_times_s", "array of numbers", "Simulated times at which snapshots are "
+           "written as well, strictly increasing, from 0 to scenario.end_time_s; the time "
+           "step is shortened to land on each exactly. Alone, the snapshots are at these "
+           "times only; with snapshot_interval_s, at both.", "s", absent="none"),
     KeyDoc("mass_balance_interval_s", "number", "Simulated time between rows of "
            "mass_balance.csv (> 0).", "s"),
     KeyDoc("checkpoint_interval_s", "number", "> 0 writes a checkpoint at the first step at or "
@@ -346,5 +369,5 @@ OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into i
 ))
 
 TABLES: tuple[TableDoc, ...] = (SCENARIO, TERRAIN, INITIAL_WATER, WALLS, INFLOWS, BREACH,
-                                SINKS, GAUGES, NUMERICS, OUTPUT)
+                                SINKS, GAUGES, FLUX_LINES, NUMERICS, OUTPUT)
 """Every table of the scenario file, in the order the reference lists them."""

@@ -20,6 +20,7 @@ from floodsph.scenario.config import (
     SIDES,
     TOP_KEYS,
     Edges,
+    FluxLine,
     Gauges,
     Inflow,
     InitialWater,
@@ -60,9 +61,10 @@ def scenario_from_dict(data: dict, *, source: str, base_dir: Path) -> Scenario:
     """
     r = Reader(source, Path(base_dir))
     r.check_keys(data, "", TOP_KEYS)
+    info = _info(r, data)
     return Scenario(
         path=(Path(base_dir) / Path(source).name).resolve(),
-        scenario=_info(r, data),
+        scenario=info,
         terrain=_terrain(r, data),
         initial_water=tuple(
             _initial_water(r, t, join("initial_water", i))
@@ -78,8 +80,9 @@ def scenario_from_dict(data: dict, *, source: str, base_dir: Path) -> Scenario:
             _sink(r, t, join("sinks", i)) for i, t in enumerate(r.table_array(data, "sinks"))
         ),
         gauges=_gauges(r, data),
+        flux_lines=_flux_lines(r, data),
         numerics=_numerics(r, data),
-        output=_output(r, data),
+        output=_output(r, data, info.end_time_s),
     )
 
 
@@ -325,6 +328,41 @@ def _gauges(r: Reader, data: dict) -> Gauges | None:
     )
 
 
+def _flux_lines(r: Reader, data: dict) -> tuple[FluxLine, ...]:
+    """``[[flux_lines]]``: each a unique ``name`` and a ``polyline`` of at least two points and
+    a non-zero length (it may cross itself: a crossing is then counted once per passage)."""
+    lines: list[FluxLine] = []
+    for i, t in enumerate(r.table_array(data, "flux_lines")):
+        p = join("flux_lines", i)
+        r.check_keys(t, p, ("name", "polyline"))
+        name = r.string(t, p, "name")
+        problem = flux_name_problem(name)
+        if problem is not None:
+            raise r.fail(join(p, "name"), problem)
+        if name in (line.name for line in lines):
+            raise r.fail(join(p, "name"), f"{name!r} names an earlier flux line too; each "
+                                          "needs its own name (it heads a column of flux.csv)")
+        points = r.points(t, p, "polyline", at_least=2)
+        length = sum(((x1 - x0) ** 2 + (y1 - y0) ** 2) ** 0.5
+                     for (x0, y0), (x1, y1) in zip(points[:-1], points[1:], strict=True))
+        if not length > 0.0:
+            raise r.fail(join(p, "polyline"), f"the line has zero length (all its points are "
+                                              f"{list(points[0])}); give two distinct points")
+        lines.append(FluxLine(name=name, polyline=points))
+    return tuple(lines)
+
+
+def flux_name_problem(name: str) -> str | None:
+    """Why ``name`` cannot name a flux line (a column ``<name>_m3s`` of flux.csv), or None."""
+    if not name.strip():
+        return "must be a non-empty name"
+    bad = [c for c in name if c in ",\"\n\r" or ord(c) < 32 or ord(c) == 127]
+    if bad:
+        return (f"must be a name without commas, quotes or control characters (it heads a "
+                f"column of flux.csv), got {describe(name)}")
+    return None
+
+
 def _numerics(r: Reader, data: dict) -> Numerics:
     """``[numerics]`` straight into :class:`~floodsph.scenario.numerics.Numerics`: each key read as
     the type of its field, then checked by ``Numerics`` itself (bounds, the refinement rule)."""
@@ -347,7 +385,28 @@ def _numerics(r: Reader, data: dict) -> Numerics:
         raise r.fail(join(p, exc.key), exc.problem) from None
 
 
-def _output(r: Reader, data: dict) -> OutputConfig:
+def _snapshot_times(r: Reader, t: dict, p: str, end_time_s: float) -> tuple[float, ...]:
+    """``output.snapshot_times_s``: times [s] from 0 to the end time, strictly increasing."""
+    if "snapshot_times_s" not in t:
+        return ()
+    where = join(p, "snapshot_times_s")
+    value = t["snapshot_times_s"]
+    if not isinstance(value, list):
+        raise r.fail(where, f"expected an array of times in seconds, got {describe(value)}")
+    times = tuple(r.number({"v": v}, join(where, k), "v") for k, v in enumerate(value))
+    for k, time in enumerate(times):
+        if time < 0.0:
+            raise r.fail(join(where, k), f"{time:g} s is before the start of the run (0 s)")
+        if time > end_time_s:
+            raise r.fail(join(where, k), f"{time:g} s is beyond the end of the run, "
+                                         f"scenario.end_time_s = {end_time_s:g} s")
+        if k and time <= times[k - 1]:
+            raise r.fail(join(where, k), f"{time:g} s does not follow {times[k - 1]:g} s; the "
+                                         "times must be strictly increasing")
+    return times
+
+
+def _output(r: Reader, data: dict, end_time_s: float) -> OutputConfig:
     p = "output"
     keys = tuple(f.name for f in fields(OutputConfig))
     t = r.sub_table(data, "", p, keys)
@@ -368,6 +427,7 @@ def _output(r: Reader, data: dict) -> OutputConfig:
         wet_threshold_m=r.number(t, p, "wet_threshold_m", d.wet_threshold_m, ge=0.0),
         formats=formats,
         snapshot_interval_s=r.number(t, p, "snapshot_interval_s", d.snapshot_interval_s, ge=0.0),
+        snapshot_times_s=_snapshot_times(r, t, p, end_time_s),
         mass_balance_interval_s=r.number(
             t, p, "mass_balance_interval_s", d.mass_balance_interval_s, gt=0.0
         ),

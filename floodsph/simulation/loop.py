@@ -8,8 +8,9 @@ called with the simulation as their only argument.
 Every callback runs once at the start (the initial state), whenever its schedule is due after
 a step, and once at the end (the final state) unless it already ran on the last step. The
 step is shortened so that the model lands exactly on the end time and on every
-:class:`~floodsph.simulation.schedules.TimeInterval` time. After every step a guard checks
-that depth, velocity and position are finite and depth is not negative.
+:class:`~floodsph.simulation.schedules.TimeInterval` and
+:class:`~floodsph.simulation.schedules.TimeList` time. After every step a guard checks that
+depth, velocity and position are finite and depth is not negative.
 
 A stop request (``should_stop``, e.g. a SIGTERM caught by ``floodsph.simulation.stop_signals``)
 ends the loop after the step and its callbacks, without the final calls: :meth:`Simulation.state` is
@@ -26,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from floodsph.simulation.schedules import TimeInterval, time_tolerance
+from floodsph.simulation.schedules import TimeInterval, TimeList, time_tolerance
 
 log = logging.getLogger(__name__)
 
@@ -91,11 +92,11 @@ class Simulation:
 
     def dt_max(self) -> float:
         """The longest step that does not jump over the end time or an aligned TimeInterval
-        time [s]."""
+        or TimeList time [s]."""
         t = self.model.t
         targets = [self.end_time]
         targets += [s.next_time for _, s in self.callbacks
-                    if isinstance(s, TimeInterval) and s.align]
+                    if isinstance(s, TimeInterval | TimeList) and s.align]
         return min(target - t for target in targets if target > t + time_tolerance(target))
 
     def state(self) -> dict:

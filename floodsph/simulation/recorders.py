@@ -1,4 +1,5 @@
-"""The run's output recorders as simulation callbacks: map envelopes, gauges, snapshots.
+"""The run's output recorders as simulation callbacks: map envelopes, gauges, flux lines,
+snapshots.
 
 :class:`Recorders` owns the objects of ``floodsph.output`` for one run, hands their
 ``(callback, schedule)`` pairs to the :class:`~floodsph.simulation.loop.Simulation`, and writes the
@@ -11,27 +12,31 @@ through a checkpoint.
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
 import numpy as np
 
-from floodsph.io.run_names import GAUGES_NAME, SNAPSHOTS_NAME
+from floodsph.io.run_names import FLUX_NAME, GAUGES_NAME, SNAPSHOTS_NAME
 from floodsph.scenario.config import Scenario
-from floodsph.simulation.schedules import TimeInterval
+from floodsph.simulation.schedules import TimeInterval, TimeList, time_tolerance
 
 SNAPSHOTS_PART = SNAPSHOTS_NAME + ".part"
 
 
 class Recorders:
-    """Envelopes (always), gauges (``[gauges]``) and snapshots (``snapshot_interval_s > 0``).
+    """Envelopes (always), gauges (``[gauges]``), flux lines (``flux_lines``, the model's
+    ``floodsph.simulation.flux.FluxLines``, which carries its own state through a checkpoint)
+    and snapshots (``snapshot_interval_s > 0`` or ``snapshot_times_s``).
 
     ``state`` (:meth:`state` of an earlier run) continues that run's records; its snapshot
     frames are read from ``snapshots_from`` (default: this run's own ``snapshots.nc.part``).
     """
 
     def __init__(self, scenario: Scenario, terrain, gauge_points, out: Path,
-                 state: dict | None = None, snapshots_from: Path | None = None):
+                 state: dict | None = None, snapshots_from: Path | None = None,
+                 flux_lines=None):
         from floodsph.output.envelopes import Envelopes
         from floodsph.output.grid import OutputGrid
 
@@ -46,8 +51,9 @@ class Recorders:
 
             self.gauges = Gauges(gauge_points, scenario.gauges.interval_s, wet_threshold=wet,
                                  start=scenario.start)
+        self.flux_lines = flux_lines
         self.snapshots = None
-        if scenario.output.snapshot_interval_s > 0:
+        if scenario.output.snapshot_interval_s > 0 or scenario.output.snapshot_times_s:
             from floodsph.output.netcdf import SnapshotWriter
 
             self.snapshots = SnapshotWriter(
@@ -73,11 +79,32 @@ class Recorders:
         out = [(self.record_envelopes, TimeInterval(self.envelopes.interval_s, align=False))]
         if self.gauges is not None:
             out.append((self.record_gauges, TimeInterval(self.gauges.interval_s)))
+        if self.flux_lines is not None:
+            out.append((self.record_flux, TimeInterval(self.scenario.flux_interval_s)))
         if self.snapshots is not None:
-            out.append(
-                (self.record_snapshot, TimeInterval(self.scenario.output.snapshot_interval_s))
-            )
+            out.append((self.record_snapshot, self.snapshot_schedule()))
         return out
+
+    def snapshot_schedule(self):
+        """Every ``snapshot_interval_s``, or, with ``snapshot_times_s``, at those times and
+        the multiples of the interval (if any) up to the end time."""
+        o = self.scenario.output
+        if not o.snapshot_times_s:
+            return TimeInterval(o.snapshot_interval_s)
+        times = set(o.snapshot_times_s)
+        if o.snapshot_interval_s > 0:
+            end = self.scenario.end_time_s
+            count = math.floor(end / o.snapshot_interval_s + time_tolerance(end))
+            times.update(k * o.snapshot_interval_s for k in range(1, count + 1))
+        return TimeList(sorted(times))
+
+    def snapshot_due(self, t: float) -> bool:
+        """False at the start and the end of a run whose snapshots are at listed times only
+        (``snapshot_times_s`` without an interval), unless those times are listed."""
+        o = self.scenario.output
+        if o.snapshot_interval_s > 0 or not o.snapshot_times_s:
+            return True
+        return any(abs(t - listed) <= time_tolerance(listed) for listed in o.snapshot_times_s)
 
     def record_envelopes(self, sim) -> None:
         self.envelopes.record(sim.model)
@@ -85,13 +112,20 @@ class Recorders:
     def record_gauges(self, sim) -> None:
         self.gauges.record(sim.model)
 
+    def record_flux(self, sim) -> None:
+        self.flux_lines.record(sim.model.t)
+
     def record_snapshot(self, sim) -> None:
         from floodsph.output.rasterise import rasterise
 
+        if not self.snapshot_due(sim.model.t):
+            return
         p = sim.model.particles
         d, u, v, _ = rasterise(self.grid, p.x, p.y, p.u, p.v, p.m, p.rho, p.h,
                                level=sim.model.surface_levels(), walls=sim.model.map_walls())
-        self.snapshots.append(sim.model.t, d, u, v)
+        with np.errstate(invalid="ignore"):
+            level = np.where(d > self.envelopes.wet_threshold, d + self.grid.bed, np.nan)
+        self.snapshots.append(sim.model.t, d, u, v, level)
 
     def write(self, into: Path) -> list[Path]:
         """Write the maps (formats of ``output.formats``), the gauge table and the snapshots
@@ -103,6 +137,8 @@ class Recorders:
                              start=self.scenario.start)
         if self.gauges is not None:
             written.append(self.gauges.write_csv(into / GAUGES_NAME))
+        if self.flux_lines is not None:
+            written.append(self.flux_lines.write_csv(into / FLUX_NAME, self.scenario.start))
         if self.snapshots is not None:
             self.close()
             os.replace(self.out / SNAPSHOTS_PART, into / SNAPSHOTS_NAME)

@@ -1,4 +1,5 @@
-"""When a callback runs: every N steps, every T simulated seconds, every W wall-clock seconds.
+"""When a callback runs: every N steps, every T simulated seconds, at listed simulated times,
+every W wall-clock seconds.
 
 Schedules are small objects with ``due(sim) -> bool`` (called after every step) and
 ``reset(sim)`` (called once when the simulation starts). An aligned :class:`TimeInterval`
@@ -11,6 +12,7 @@ the first step at or after each mark.
 
 from __future__ import annotations
 
+import bisect
 import math
 import time
 
@@ -62,6 +64,35 @@ class TimeInterval:
 
     def __repr__(self) -> str:
         return f"TimeInterval({self.interval:g} s{'' if self.align else ', not aligned'})"
+
+
+class TimeList:
+    """Due at the listed simulated times [s] (increasing); the time step lands on each
+    (aligned, as :class:`TimeInterval`). Due at the first step at or after a time, once."""
+
+    align = True
+
+    def __init__(self, times):
+        self.times = tuple(float(t) for t in times)
+        if any(b <= a for a, b in zip(self.times[:-1], self.times[1:], strict=True)):
+            raise ValueError(f"TimeList needs increasing times, got {self.times}")
+        self.next_time = self.times[0] if self.times else math.inf
+
+    def reset(self, sim) -> None:
+        """The first listed time after ``sim.model.t`` (infinity after the last)."""
+        t = sim.model.t
+        k = bisect.bisect_right(self.times, t + time_tolerance(t))
+        self.next_time = self.times[k] if k < len(self.times) else math.inf
+
+    def due(self, sim) -> bool:
+        t = sim.model.t
+        if t < self.next_time - time_tolerance(self.next_time):
+            return False
+        self.reset(sim)
+        return True
+
+    def __repr__(self) -> str:
+        return f"TimeList({len(self.times)} times)"
 
 
 class WallTimeInterval:

@@ -40,8 +40,8 @@ def sigterm_at(step: int | None):
 
 @pytest.fixture
 def dam_break(valley_dem, tmp_path):
-    def make(stepping: str = "global", end_time: float = 40.0):
-        return load_scenario(write_dam_break(tmp_path, stepping, end_time))
+    def make(stepping: str = "global", end_time: float = 40.0, flux: bool = False):
+        return load_scenario(write_dam_break(tmp_path, stepping, end_time, flux))
 
     return make
 
@@ -55,8 +55,10 @@ def assert_same_outputs(a, b):
     for name in MAPS:
         with rasterio.open(a / f"{name}.tif") as x, rasterio.open(b / f"{name}.tif") as y:
             assert np.array_equal(x.read(1), y.read(1), equal_nan=True), name
-    for table in ("gauges.csv", "mass_balance.csv"):
-        assert (a / table).read_text() == (b / table).read_text(), table
+    for table in ("gauges.csv", "mass_balance.csv", "flux.csv"):
+        assert (a / table).exists() == (b / table).exists(), table
+        if (a / table).exists():
+            assert (a / table).read_text() == (b / table).read_text(), table
     with xr.open_dataset(a / "flood_maps.nc") as x, xr.open_dataset(b / "flood_maps.nc") as y:
         xr.testing.assert_identical(x.drop_attrs(), y.drop_attrs())
     with xr.open_dataset(a / "snapshots.nc") as x, xr.open_dataset(b / "snapshots.nc") as y:
@@ -66,7 +68,7 @@ def assert_same_outputs(a, b):
 @pytest.mark.parametrize("stepping", ["global", "local"])
 def test_a_run_stopped_twice_and_resumed_equals_the_uninterrupted_run(dam_break, tmp_path,
                                                                         stepping):
-    scenario = dam_break(stepping)
+    scenario = dam_break(stepping, flux=True)
     whole = run(scenario, tmp_path / "whole")
     assert whole["status"] == "completed"
     assert whole["splits"] > 0 and whole["merges"] > 0  # refinement is exercised
@@ -86,8 +88,14 @@ def test_a_run_stopped_twice_and_resumed_equals_the_uninterrupted_run(dam_break,
     assert last["status"] == "completed"
     assert last["resumed_from"] == [first["sim_time_s"], second["sim_time_s"]]
     for key in ("steps", "splits", "merges", "particles_final", "volume_in_m3",
-                "mass_error_rel"):
+                "mass_error_rel", "flux_lines", "volume_out_sides_m3"):
         assert last[key] == whole[key], key
+    assert whole["flux_lines"][0]["volume_net_m3"] > 0  # water crossed the floor line
+    assert (tmp_path / "whole" / "flux.csv").exists()
+    out = (sum(whole["volume_out_sinks_m3"]) + sum(whole["volume_out_sides_m3"].values())
+           + whole["volume_out_other_m3"])
+    assert set(whole["volume_out_sides_m3"]) == {"west", "east", "south", "north"}
+    assert out == pytest.approx(whole["volume_out_m3"], rel=1e-12)
     assert_same_outputs(tmp_path / "whole", tmp_path / "parts")
 
 

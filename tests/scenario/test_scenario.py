@@ -119,8 +119,8 @@ POLY = "[[0, 0], [10, 0], [10, 10]]"
         (("cfl = 0.3", "cfll = 0.3"),
          "numerics.cfll: unknown key; allowed keys: cfl, density_tol, "),
         (("[scenario]", "bogus = 1\n[scenario]"),
-         "bogus: unknown key; allowed keys: gauges, inflows, initial_water, numerics, output, "
-         "scenario, sinks, terrain, walls"),
+         "bogus: unknown key; allowed keys: flux_lines, gauges, inflows, initial_water, "
+         "numerics, output, scenario, sinks, terrain, walls"),
         (("level_m = 100.0", "level_m = 100.0\ncolour = 1"),
          "initial_water[0].colour: unknown key; allowed keys: crs, depth, file, layer, level_m, "
          "polygon"),
