@@ -40,7 +40,24 @@ class IterationInterval:
         return f"IterationInterval({self.n})"
 
 
-class TimeInterval:
+class _SimulatedTimes:
+    """A schedule due at the first step at or after its ``next_time`` [s], which ``reset``
+    moves on."""
+
+    next_time: float
+
+    def reset(self, sim) -> None:
+        raise NotImplementedError
+
+    def due(self, sim) -> bool:
+        t = sim.model.t
+        if t < self.next_time - time_tolerance(self.next_time):
+            return False
+        self.reset(sim)
+        return True
+
+
+class TimeInterval(_SimulatedTimes):
     """Due at simulated times ``k * interval`` (k = 1, 2, ...) [s]; with ``align`` the time
     step lands on them, otherwise it is due at the first step at or after each."""
 
@@ -55,18 +72,11 @@ class TimeInterval:
         t = sim.model.t
         self.next_time = (math.floor(t / self.interval + time_tolerance(t)) + 1) * self.interval
 
-    def due(self, sim) -> bool:
-        t = sim.model.t
-        if t < self.next_time - time_tolerance(self.next_time):
-            return False
-        self.reset(sim)
-        return True
-
     def __repr__(self) -> str:
         return f"TimeInterval({self.interval:g} s{'' if self.align else ', not aligned'})"
 
 
-class TimeList:
+class TimeList(_SimulatedTimes):
     """Due at the listed simulated times [s] (increasing); the time step lands on each
     (aligned, as :class:`TimeInterval`). Due at the first step at or after a time, once."""
 
@@ -83,13 +93,6 @@ class TimeList:
         t = sim.model.t
         k = bisect.bisect_right(self.times, t + time_tolerance(t))
         self.next_time = self.times[k] if k < len(self.times) else math.inf
-
-    def due(self, sim) -> bool:
-        t = sim.model.t
-        if t < self.next_time - time_tolerance(self.next_time):
-            return False
-        self.reset(sim)
-        return True
 
     def __repr__(self) -> str:
         return f"TimeList({len(self.times)} times)"
