@@ -68,7 +68,9 @@ class Inputs:
     line and direction in the terrain's CRS (``floodsph.io.coordinates``). ``warnings``
     lists the inputs accepted with a warning (each also logged at WARNING); ``conversions``
     the units the input files were converted from (hydrographs in hours or cubic feet per
-    second, dates), one sentence per file.
+    second, dates), one sentence per file. ``wall_entries`` are the ``[[walls]]`` entries
+    (``floodsph.scenario.config.Wall``, their crest and breach), one per polyline of
+    ``walls``.
     """
 
     terrain: Terrain
@@ -86,6 +88,7 @@ class Inputs:
     memory: MemoryEstimate
     warnings: list[str] = field(default_factory=list)
     conversions: list[str] = field(default_factory=list)
+    wall_entries: tuple = ()
 
 
 def prepare_inputs(scenario: Scenario) -> Inputs:
@@ -163,6 +166,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         memory=memory,
         warnings=warnings,
         conversions=conversions,
+        wall_entries=tuple(scenario.walls),
     )
 
 
