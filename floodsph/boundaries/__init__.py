@@ -1,4 +1,4 @@
-"""Open boundaries: inflow sections, open DEM edges and sinks.
+"""Open boundaries: inflow sections, open DEM edges, sinks, and weirs over crest walls.
 
 Each keeps the contract of ``floodsph.boundaries.protocol.Boundary`` with the model.
 """
@@ -6,5 +6,6 @@ Each keeps the contract of ``floodsph.boundaries.protocol.Boundary`` with the mo
 from floodsph.boundaries.inflow import Inflow
 from floodsph.boundaries.open_edges import OpenEdges
 from floodsph.boundaries.sink import Sink
+from floodsph.boundaries.weir import Weir
 
-__all__ = ["Inflow", "OpenEdges", "Sink"]
+__all__ = ["Inflow", "OpenEdges", "Sink", "Weir"]

@@ -69,7 +69,9 @@ class Inputs:
     terrain's CRS (``floodsph.io.coordinates``). ``warnings`` lists the inputs accepted
     with a warning (each also logged at WARNING); ``conversions`` the units the input files
     were converted from (hydrographs in hours or cubic feet per second, dates), one sentence
-    per file.
+    per file. ``wall_entries`` are the ``[[walls]]`` entries
+    (``floodsph.scenario.config.Wall``, their crest and breach), one per polyline of
+    ``walls``.
     """
 
     terrain: Terrain
@@ -88,6 +90,7 @@ class Inputs:
     warnings: list[str] = field(default_factory=list)
     conversions: list[str] = field(default_factory=list)
     flux_lines: list[tuple[str, np.ndarray]] = field(default_factory=list)
+    wall_entries: tuple = ()
 
 
 def prepare_inputs(scenario: Scenario) -> Inputs:
@@ -167,6 +170,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         conversions=conversions,
         flux_lines=[(line.name, local_points(terrain, line.polyline))
                     for line in scenario.flux_lines],
+        wall_entries=tuple(scenario.walls),
     )
 
 

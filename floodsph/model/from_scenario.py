@@ -11,8 +11,10 @@ from dataclasses import replace
 import numpy as np
 
 from floodsph.boundaries import Inflow, Sink
+from floodsph.boundaries.crest import Crest, check_crest_above_bed, resolve_breach
 from floodsph.boundaries.open_edges import SIDES
 from floodsph.boundaries.protocol import Boundary
+from floodsph.boundaries.weir import IDEAL_COEFFICIENT, Weir, bed_at
 from floodsph.model.builder import set_up_model
 from floodsph.model.refinement import Refiner
 from floodsph.scenario.config import Edges, Scenario
@@ -67,4 +69,27 @@ def open_boundaries(scenario: Scenario, inputs, numerics) -> list[Boundary]:
     reach = 4.0 * seeded_smoothing_length(numerics.kappa, numerics.particle_spacing_m)
     for polygon in inputs.sinks:
         out.append(Sink(polygon, terrain, reach))
+    out.extend(weirs(inputs, numerics, source))
+    return out
+
+
+def weirs(inputs, numerics, source: str) -> list[Weir]:
+    """The ``[[walls]]`` with a ``crest_m`` as weirs (``floodsph.boundaries.weir``), their
+    breaches resolved and checked on the wall and the DEM."""
+    terrain = inputs.terrain
+    out = []
+    for i, (entry, line) in enumerate(zip(getattr(inputs, "wall_entries", ()), inputs.walls,
+                                          strict=False)):
+        if entry.crest_m is None:
+            continue
+        label = f"walls[{i}]" if entry.feature is None else f"walls[{i}] ({entry.feature})"
+        name = f"{source}: {label}"
+        crest = Crest(line, entry.crest_m)
+        check_crest_above_bed(crest, lambda x, y: bed_at(terrain, x, y), name)
+        if entry.breach is not None:
+            crest = Crest(line, entry.crest_m, resolve_breach(entry.breach, crest,
+                                                              f"{name}.breach"))
+        coefficient = entry.discharge_coefficient or IDEAL_COEFFICIENT
+        out.append(Weir(crest, numerics.particle_spacing_m, numerics.kappa, coefficient,
+                        name=label))
     return out

@@ -355,7 +355,7 @@ def _save(sim, scenario, threads, manifest, mass, recorders, work, wall_start) -
 
 
 def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
-    from floodsph.boundaries import Inflow
+    from floodsph.boundaries import Inflow, Weir
 
     manifest["finished"] = now_iso()
     manifest["wall_time_s"] = wall_time
@@ -378,6 +378,10 @@ def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
     )
     if getattr(model, "flux_lines", None) is not None:
         manifest["flux_lines"] = model.flux_lines.summary()
+    weirs = [b for b in model.boundaries if isinstance(b, Weir)]
+    if weirs:  # the volume passed over each crest wall (floodsph.boundaries.weir)
+        manifest["walls_overtopped_m3"] = {b.name: b.summary()["volume_passed_m3"]
+                                           for b in weirs}
     if mass is not None:
         manifest["mass_error_rel"] = mass.budget(model).error_rel
 

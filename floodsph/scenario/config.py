@@ -101,16 +101,56 @@ class InitialWater:
     feature: str | None = None
 
 
+class BreachGrowth(Enum):
+    """How a wall breach grows over its formation time (``floodsph.breach.formulas.progression``):
+    linearly, or along HEC-RAS's sine wave, slow at the start and the end."""
+
+    LINEAR = "linear"
+    SINE = "sine"
+
+
+@dataclass(frozen=True)
+class WallBreach:
+    """``[walls.breach]``: a trapezoidal breach that opens in a crest wall
+    (``floodsph.boundaries.crest``, ``docs/structures.md``).
+
+    ``centre_m`` is the distance along the wall from its first vertex [m] (in the model's
+    metres); ``invert_m`` the final breach bottom elevation [m]; ``bottom_width_m`` its final
+    bottom width [m]; ``side_slope`` H:V; the breach starts at ``start_s`` and is fully formed
+    ``formation_s`` later. With ``froehlich`` the final width and the formation time come from
+    Froehlich (2008) for ``reservoir_volume_m3`` (``floodsph.breach.formulas``).
+    """
+
+    centre_m: float
+    invert_m: float
+    bottom_width_m: float | None = None
+    formation_s: float | None = None
+    side_slope: float = 1.0
+    start_s: float = 0.0
+    growth: BreachGrowth = BreachGrowth.LINEAR
+    froehlich: bool = False
+    reservoir_volume_m3: float | None = None
+
+
 @dataclass(frozen=True)
 class Wall:
     """``[[walls]]``: a polyline water cannot cross (closed: a solid footprint), or the lines
-    and polygon outlines of a vector ``file`` (+ ``layer``, ``crs``; see InitialWater)."""
+    and polygon outlines of a vector ``file`` (+ ``layer``, ``crs``; see InitialWater).
+
+    With ``crest_m`` (one elevation [m], or one per vertex, linear in between) water above
+    the crest passes over the wall as over a broad-crested weir of ``discharge_coefficient``
+    (None: the ideal (2/3)^(3/2)), and ``breach`` may open a breach in it
+    (``floodsph.boundaries.weir``). Without it the wall is infinitely high.
+    """
 
     polyline: tuple[Point, ...] | None = None
     file: Path | None = None
     layer: str | None = None
     crs: str | None = None
     feature: str | None = None
+    crest_m: float | tuple[float, ...] | None = None
+    discharge_coefficient: float | None = None
+    breach: WallBreach | None = None
 
     @property
     def closed(self) -> bool:

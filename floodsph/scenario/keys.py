@@ -24,6 +24,7 @@ from enum import Enum
 from floodsph.breach.params import BreachParams
 from floodsph.scenario.config import (
     SIDES,
+    BreachGrowth,
     Edges,
     FluxLine,
     Gauges,
@@ -35,6 +36,7 @@ from floodsph.scenario.config import (
     Sink,
     TerrainConfig,
     Wall,
+    WallBreach,
 )
 from floodsph.scenario.numerics import (
     Momentum,
@@ -207,6 +209,40 @@ WALLS = TableDoc("walls", True, "Lines water cannot cross (embankments, flood wa
            "point = last) is a solid footprint such as a building.", "m",
            absent="none (give polyline or file)"),
     *VECTOR_KEYS,
+    KeyDoc("crest_m", "number or array of numbers", "The wall's crest elevation, in the DEM's "
+           "vertical datum: one value, or one per polyline vertex (linear in between; inline "
+           "polylines only). Water standing above it passes over the wall as over a "
+           "broad-crested weir, reduced when the far side is submerged (Villemonte); the "
+           "particles still never cross the wall (docs/structures.md). A crest below the "
+           "bed at every vertex is refused.", "m",
+           absent="none: the wall is infinitely high"),
+    KeyDoc("discharge_coefficient", "number", "C of the weir law q = C sqrt(g) H^1.5 per "
+           "metre of crest (dimensionless; with crest_m).",
+           absent="(2/3)^1.5 = 0.544, an ideal broad crest"),
+    KeyDoc("breach", "table", "A breach that opens in the crest (see [walls.breach]; with "
+           "crest_m).", absent="none"),
+))
+
+WALL_BREACH = TableDoc("walls.breach", False, "A trapezoidal breach that lowers the crest of "
+                       "a crest wall over time, from a notch at the crest to its final size "
+                       "(HEC-RAS's breach progression, docs/structures.md).", WallBreach, keys=(
+    KeyDoc("centre_m", "number", "Where the breach is centred: the distance along the wall "
+           "from its first vertex (at most the wall's length).", "m", required=True),
+    KeyDoc("invert_m", "number", "The final breach bottom elevation (below the crest there).",
+           "m", required=True),
+    KeyDoc("bottom_width_m", "number", "The final bottom width (no wider than the wall).", "m",
+           absent="required unless froehlich = true"),
+    KeyDoc("formation_s", "number", "The time from the start to the fully formed breach (> 0).",
+           "s", absent="required unless froehlich = true"),
+    KeyDoc("side_slope", "number", "The breach's side slopes, horizontal : vertical (0: "
+           "vertical sides)."),
+    KeyDoc("start_s", "number", "When the breach starts to open (>= 0).", "s"),
+    KeyDoc("growth", "string", "How the breach grows over formation_s: `linear`, or HEC-RAS's "
+           "`sine` wave, fraction (1 - cos(pi t / t_f)) / 2.", choices=BreachGrowth),
+    KeyDoc("froehlich", "boolean", "Take the final width (B_avg - side_slope h_b) and the "
+           "formation time from Froehlich (2008), overtopping, as `floodsph breach` does."),
+    KeyDoc("reservoir_volume_m3", "number", "With froehlich = true: V_w, the volume above the "
+           "breach invert at failure.", "m3", absent="none (required with froehlich = true)"),
 ))
 
 INFLOWS = TableDoc("inflows", True, "A breach section where water enters the model, from a "
@@ -368,6 +404,6 @@ OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into i
            "on a schedule (a stop signal still writes one).", "s"),
 ))
 
-TABLES: tuple[TableDoc, ...] = (SCENARIO, TERRAIN, INITIAL_WATER, WALLS, INFLOWS, BREACH,
-                                SINKS, GAUGES, FLUX_LINES, NUMERICS, OUTPUT)
+TABLES: tuple[TableDoc, ...] = (SCENARIO, TERRAIN, INITIAL_WATER, WALLS, WALL_BREACH, INFLOWS,
+                                BREACH, SINKS, GAUGES, FLUX_LINES, NUMERICS, OUTPUT)
 """Every table of the scenario file, in the order the reference lists them."""

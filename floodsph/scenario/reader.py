@@ -9,7 +9,7 @@ the :class:`~floodsph.scenario.config.Scenario`.
 
 from __future__ import annotations
 
-from dataclasses import fields
+from dataclasses import fields, replace
 from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -19,6 +19,7 @@ from floodsph.io.roughness import N_DEFAULT, N_STRICKLER, strickler_text
 from floodsph.scenario.config import (
     SIDES,
     TOP_KEYS,
+    BreachGrowth,
     Edges,
     FluxLine,
     Gauges,
@@ -31,6 +32,7 @@ from floodsph.scenario.config import (
     Sink,
     TerrainConfig,
     Wall,
+    WallBreach,
 )
 from floodsph.scenario.numerics import SCENARIO_KEYS as NUMERICS_KEYS
 from floodsph.scenario.numerics import Numerics, NumericsError
@@ -255,12 +257,94 @@ VECTOR_KEYS = ("file", "layer", "crs")
 """Keys of a geometry read from a vector file (``Reader.vector_source``)."""
 
 
+CREST_KEYS = ("crest_m", "discharge_coefficient", "breach")
+"""Keys of a wall with a crest that water passes over (``floodsph.boundaries.weir``)."""
+WALL_BREACH_KEYS = ("centre_m", "invert_m", "bottom_width_m", "formation_s", "side_slope",
+                    "start_s", "growth", "froehlich", "reservoir_volume_m3")
+"""Keys of ``[walls.breach]`` (``floodsph.scenario.config.WallBreach``)."""
+
+
 def _wall(r: Reader, t: dict, p: str) -> Wall:
-    r.check_keys(t, p, ("polyline", *VECTOR_KEYS))
+    r.check_keys(t, p, ("polyline", *VECTOR_KEYS, *CREST_KEYS))
     source = r.vector_source(t, p, "polyline")
-    if source:
-        return Wall(**source)
-    return Wall(polyline=r.polyline(t, p, "polyline"))
+    crest = _crest(r, t, p, None if source else len(r.points(t, p, "polyline", at_least=2)))
+    coefficient = r.number(t, p, "discharge_coefficient", None, gt=0.0)
+    breach = _wall_breach(r, t, p, crest)
+    if crest is None:
+        for key in ("discharge_coefficient", "breach"):
+            if key in t:
+                raise r.fail(join(p, key), "needs crest_m (a wall without a crest is "
+                                           "infinitely high)")
+    wall = Wall(**source) if source else Wall(polyline=r.polyline(t, p, "polyline"))
+    return replace(wall, crest_m=crest, discharge_coefficient=coefficient, breach=breach)
+
+
+def _crest(r: Reader, t: dict, p: str, vertices: int | None) -> float | tuple[float, ...] | None:
+    """``walls[i].crest_m``: one elevation [m], or one per vertex of an inline polyline."""
+    if "crest_m" not in t:
+        return None
+    value = t["crest_m"]
+    where = join(p, "crest_m")
+    crest: float | tuple[float, ...]
+    if not isinstance(value, list):
+        crest = r.number(t, p, "crest_m")
+        values: tuple[float, ...] = (crest,)
+    else:
+        if vertices is None:
+            raise r.fail(where, "a list of elevations needs an inline polyline (a wall read "
+                                "from a file takes one number)")
+        if len(value) != vertices:
+            raise r.fail(where, f"has {len(value)} elevations but the polyline has {vertices} "
+                                "vertices; give one per vertex, or one number")
+        values = tuple(r.number({"v": v}, join(where, k), "v") for k, v in enumerate(value))
+        crest = values
+    for v in values:
+        if abs(v) > ELEVATION_LIMIT_M:
+            raise r.fail(where, f"{v:g} m is beyond +-{ELEVATION_LIMIT_M:g} m, no crest on Earth")
+    return crest
+
+
+def _wall_breach(r: Reader, t: dict, p: str, crest) -> WallBreach | None:
+    """``[walls.breach]``: a breach opening in a crest wall; the checks that need the wall's
+    length and the DEM are ``floodsph.boundaries.crest``'s."""
+    if "breach" not in t:
+        return None
+    where = join(p, "breach")
+    b = r.table(t["breach"], where)
+    r.check_keys(b, where, WALL_BREACH_KEYS)
+    froehlich = b.get("froehlich", False)
+    if not isinstance(froehlich, bool):
+        raise r.fail(join(where, "froehlich"), f"expected true or false, got {describe(froehlich)}")
+    invert = r.number(b, where, "invert_m")
+    if crest is not None and not isinstance(crest, tuple) and invert >= crest:
+        raise r.fail(join(where, "invert_m"), f"{invert:g} m is not below the crest "
+                                              f"({crest:g} m): the breach would open nothing")
+    if froehlich:
+        for key in ("bottom_width_m", "formation_s"):
+            if key in b:
+                raise r.fail(join(where, key), "give it or froehlich = true (which computes "
+                                               "it), not both")
+        if "reservoir_volume_m3" not in b:
+            raise r.fail(join(where, "reservoir_volume_m3"), "required with froehlich = true "
+                                                              "(V_w of Froehlich 2008)")
+    else:
+        for key in ("bottom_width_m", "formation_s"):
+            if key not in b:
+                raise r.fail(join(where, key), "required key is missing (or set froehlich = "
+                                               "true)")
+        if "reservoir_volume_m3" in b:
+            raise r.fail(join(where, "reservoir_volume_m3"), "only used with froehlich = true")
+    return WallBreach(
+        centre_m=r.number(b, where, "centre_m", ge=0.0),
+        invert_m=invert,
+        bottom_width_m=r.number(b, where, "bottom_width_m", None, ge=0.0),
+        formation_s=r.number(b, where, "formation_s", None, gt=0.0),
+        side_slope=r.number(b, where, "side_slope", WallBreach.side_slope, ge=0.0),
+        start_s=r.number(b, where, "start_s", WallBreach.start_s, ge=0.0),
+        growth=r.choice(b, where, "growth", BreachGrowth, WallBreach.growth),
+        froehlich=froehlich,
+        reservoir_volume_m3=r.number(b, where, "reservoir_volume_m3", None, gt=0.0),
+    )
 
 
 def _inflow(r: Reader, t: dict, p: str) -> Inflow:
@@ -284,8 +368,6 @@ def _inflow(r: Reader, t: dict, p: str) -> Inflow:
 def _breach(r: Reader, value, where: str) -> BreachParams:
     """``[inflows.breach]`` validated by the breach module, its files made absolute and
     checked to exist (they are read when the breach is routed, ``floodsph.inputs.prepare``)."""
-    from dataclasses import replace
-
     from floodsph.breach.params import BreachParams
 
     params = BreachParams.from_mapping(r.table(value, where), where, r.base_dir,

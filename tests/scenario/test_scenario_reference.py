@@ -61,6 +61,8 @@ def accepted(folder: Path) -> dict[str, set[str]]:
     hydrograph.write_text("time_s,discharge_m3s\n0,1\n10,1\n", encoding="utf-8")
     inflow = {"line": [[0.0, 0.0], [0.0, 10.0]], "breach": {UNKNOWN: 1}}
     out["inflows.breach"] = allowed_keys(refusal({**base, "inflows": [inflow]}, folder))
+    wall = {"polyline": [[0.0, 0.0], [0.0, 10.0]], "crest_m": 1.0, "breach": {UNKNOWN: 1}}
+    out["walls.breach"] = allowed_keys(refusal({**base, "walls": [wall]}, folder))
     return out
 
 
