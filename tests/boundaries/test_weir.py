@@ -130,7 +130,7 @@ def test_steady_free_flow_stands_at_the_weir_head():
     head = (q_in / WIDTH / (IDEAL_COEFFICIENT * math.sqrt(GRAVITY))) ** (2.0 / 3.0)
     model, weir = _channel(CREST + head, Crest(WALL, CREST), inflow_q=q_in)
     run_until(model, 10.0)
-    v_start, t_start = weir.volume_passed, model.t
+    v_start, t_start = weir.volume_net, model.t
     levels, heads = [], []
     while model.t < 20.0 - 1e-9:
         model.step(20.0 - model.t)
@@ -138,7 +138,7 @@ def test_steady_free_flow_stands_at_the_weir_head():
         band = (p.x > 3.0) & (p.x < 7.0)
         levels.append(np.average(p.rho[band], weights=p.m[band] / p.rho[band]) / 1000.0)
         heads.append(np.mean(weir.head))
-    passed = (weir.volume_passed - v_start) / (model.t - t_start)
+    passed = (weir.volume_net - v_start) / (model.t - t_start)
     h_up = float(np.mean(levels)) - CREST
     assert h_up == pytest.approx(head, rel=0.10)
     assert passed == pytest.approx(WIDTH * unit_discharge(h_up), rel=0.10)
@@ -156,8 +156,9 @@ def test_the_weir_moves_water_without_making_or_losing_any():
     assert model.volume() == pytest.approx(v0, rel=1e-12)
     assert model.volume_out == 0.0
     downstream = model.particles.x > RESERVOIR
-    assert model.particles.m[downstream].sum() / 1000.0 == pytest.approx(weir.volume_passed,
+    assert model.particles.m[downstream].sum() / 1000.0 == pytest.approx(weir.volume_net,
                                                                          rel=1e-12)
+    assert weir.volume_to_left == 0.0  # the wall runs north: the reservoir is on its left
 
 
 def test_breach_opens_at_its_start_and_passes_more_and_more():
@@ -171,7 +172,7 @@ def test_breach_opens_at_its_start_and_passes_more_and_more():
     passed = []
     for t in (2.0, 2.5, 3.0, 3.5):
         run_until(model, t)
-        passed.append(weir.volume_passed)
+        passed.append(weir.volume_net)
     assert passed[0] > 0.0
     assert np.all(np.diff(passed) > 0.0)
     increments = np.diff([0.0, *passed])
