@@ -28,7 +28,7 @@ from floodsph.io.hydrograph import Hydrograph
 from floodsph.model.builder import set_up_model
 from floodsph.model.from_scenario import weirs
 from floodsph.model.terrain import Terrain
-from floodsph.scenario.numerics import Numerics, TimeStepping
+from floodsph.scenario.numerics import Momentum, Numerics, TimeStepping
 from floodsph.scenario.reader import scenario_from_dict
 
 DX = 0.25
@@ -38,7 +38,8 @@ CREST = 1.0
 WALL = np.array([[RESERVOIR, 0.0], [RESERVOIR, WIDTH]])
 
 
-def _channel(level: float, crest: Crest, closed=("south", "north"), inflow_q: float = 0.0):
+def _channel(level: float, crest: Crest, closed=("south", "north"), inflow_q: float = 0.0,
+             **numerics):
     """A flat 5 m wide channel, 20 m long, with the crest wall across it at x = 10 m and still
     water at ``level`` upstream of it; the east end open (unless closed), an inflow of
     ``inflow_q`` [m3/s] at the west end (closed when zero)."""
@@ -46,7 +47,7 @@ def _channel(level: float, crest: Crest, closed=("south", "north"), inflow_q: fl
                                     0.5)
     x, y = lattice(0.0, RESERVOIR, 0.0, WIDTH, DX)
     p = particles_with_depth(x, y, np.full(x.shape, level), DX, Numerics.kappa)
-    num = Numerics(particle_spacing_m=DX, time_stepping=TimeStepping.GLOBAL)
+    num = Numerics(particle_spacing_m=DX, **{"time_stepping": TimeStepping.GLOBAL, **numerics})
     weir = Weir(crest, DX, num.kappa, name="walls[0]")
     boundaries: list = [weir]
     if inflow_q > 0.0:
@@ -111,8 +112,13 @@ def test_breach_crest_follows_the_growth_curve(growth):
 
 
 # -- the weir in the model ----------------------------------------------------------------------
-def test_water_below_the_crest_stays_where_it_is():
-    model, weir = _channel(0.9, Crest(WALL, CREST))
+SETTINGS = [{}, {"time_stepping": TimeStepping.LOCAL}, {"momentum": Momentum.BALANCED}]
+SETTING_IDS = ["global", "local-steps", "balanced"]
+
+
+@pytest.mark.parametrize("settings", SETTINGS, ids=SETTING_IDS)
+def test_water_below_the_crest_stays_where_it_is(settings):
+    model, weir = _channel(0.9, Crest(WALL, CREST), **settings)
     v0 = model.volume()
     run_until(model, 3.0)
     assert weir.volume_passed == 0.0
@@ -146,10 +152,13 @@ def test_steady_free_flow_stands_at_the_weir_head():
     assert passed == pytest.approx(q_in, rel=0.10)
 
 
-def test_the_weir_moves_water_without_making_or_losing_any():
+@pytest.mark.parametrize("settings", SETTINGS, ids=SETTING_IDS)
+def test_the_weir_moves_water_without_making_or_losing_any(settings):
     """A closed channel: the reservoir at crest + 0.2 m spills over the crest into the dry
-    half; the water in the domain stays what it was to 1e-12."""
-    model, weir = _channel(CREST + 0.2, Crest(WALL, CREST), closed=("south", "north", "east"))
+    half; the water in the domain stays what it was to 1e-12 (with the global or local time
+    steps, the variational or balanced momentum)."""
+    model, weir = _channel(CREST + 0.2, Crest(WALL, CREST), closed=("south", "north", "east"),
+                           **settings)
     v0 = model.volume()
     run_until(model, 4.0)
     assert weir.volume_passed > 1.0  # about a third of the water above the crest
