@@ -7,7 +7,7 @@ broad-crested weir (``docs/structures.md`` §2). Per metre of crest, in free flo
     q = C sqrt(g) H_u^(3/2),   H_u = eta_u - z_c                       (1)
 
 with eta_u the upstream level and z_c the crest [m]; C = (2/3)^(3/2) = 0.544 for an ideal
-broad crest (critical depth 2 H_u / 3 on the crest; Henderson, Open Channel Flow (1966) §6.7),
+broad crest (critical depth 2 H_u / 3 on the crest; Henderson, Open Channel Flow (1966)),
 i.e. C sqrt(g) = 1.705 m^0.5/s. With the downstream level above the crest (H_d = eta_d - z_c
 > 0) the flow is reduced as Villemonte (1947) found, "Submerged weir discharge studies",
 Engineering News-Record 139, 866-869:
