@@ -7,7 +7,7 @@ broad-crested weir (``docs/structures.md`` §2). Per metre of crest, in free flo
     q = C sqrt(g) H_u^(3/2),   H_u = eta_u - z_c                       (1)
 
 with eta_u the upstream level and z_c the crest [m]; C = (2/3)^(3/2) = 0.544 for an ideal
-broad crest (critical depth 2 H_u / 3 on the crest; Henderson, Open Channel Flow (1966) §6.7),
+broad crest (critical depth 2 H_u / 3 on the crest; Henderson, Open Channel Flow (1966)),
 i.e. C sqrt(g) = 1.705 m^0.5/s. With the downstream level above the crest (H_d = eta_d - z_c
 > 0) the flow is reduced as Villemonte (1947) found, "Submerged weir discharge studies",
 Engineering News-Record 139, 866-869:
@@ -15,19 +15,21 @@ Engineering News-Record 139, 866-869:
     q_s = q (1 - (H_d / H_u)^n)^0.385,   n = 3/2                       (2)
 
 Scheme: the wall is cut into pieces about one particle spacing long. Each particle within
-2 h0 of a piece's midpoint (its nearest piece) belongs to that piece's side. Each step the level
-on each side is the mean of d + b over those particles, weighted by their area m / rho and the
-kernel W(r, h0) of the distance to the midpoint (no particle: a dry side, no level). The
+3.5 h0 of a piece's midpoint (its nearest piece) belongs to that piece's side. Each step the
+level on each side is the mean of d + b over those particles, weighted by their area m / rho
+and the kernel W(r, h0) of the distance r to the point 1.5 h0 off the midpoint on that side
+(no particle: a dry side, no level). The
 higher side is upstream; (1)-(2) give the piece's discharge Q = q L, and Q dt is owed to the
 downstream side. Once a piece owes a particle's worth, V_e = d_e L dx with d_e the larger of
 the critical depth (q^2 / g)^(1/3) and the downstream depth, that volume (at most half the
-water of the piece's upstream side) is taken from its upstream particles in proportion to
-their mass (each keeping the same fraction of its mass; one left with less than a quarter of
-a lattice particle, m < rho dx^2 / 4, is taken whole) and injected as one new particle half a
+water of the piece's upstream side) is taken from its upstream particles nearest the wall
+first (one left with less than a quarter of a lattice particle, m < rho dx^2 / 4, is taken
+whole: taking from all in proportion to their mass left a layer of ever smaller particles
+against the wall, which read the level low) and injected as one new particle half a
 spacing downstream of the piece, moving away from the wall at q / d_e (critical flow
 sqrt(g d_c) when free). The mass taken is the mass injected, to the last bit, so the weir
-leaves the water volume unchanged; the volume passed is counted in :attr:`Weir.volume_passed`
-(run.json's ``walls_overtopped_m3``).
+leaves the water volume unchanged; the volume passed each way is counted
+(:meth:`Weir.summary`, run.json's ``walls_overtopped_m3``).
 """
 
 from __future__ import annotations
@@ -148,7 +150,8 @@ class Weir:
         self._box = (lo, hi)
         self.owed = np.zeros(self.pieces)
         self.emitted = np.zeros(self.pieces, dtype=np.int64)
-        self.volume_passed = 0.0
+        self.volume_to_right = 0.0
+        self.volume_to_left = 0.0
         self.discharge = np.zeros(self.pieces)
         self.head = np.full(self.pieces, -np.inf)
         self.levels = np.full((self.pieces, 2), -np.inf)
@@ -238,7 +241,10 @@ class Weir:
                 continue
             volume = mass / RHO_WATER
             self.owed[k] -= volume
-            self.volume_passed += volume
+            if up[k] == 1:
+                self.volume_to_right += volume
+            else:
+                self.volume_to_left += volume
             new.append(self._particle(int(k), int(up[k]), mass, float(d_e[k]), float(q[k])))
         if drop.any():
             p.keep(~drop)
@@ -303,9 +309,21 @@ class Weir:
         mask[idx] = True
         return mask
 
+    @property
+    def volume_passed(self) -> float:
+        """The volume passed over the wall so far [m3], both ways."""
+        return self.volume_to_right + self.volume_to_left
+
+    @property
+    def volume_net(self) -> float:
+        """The volume passed from the left of the wall to its right [m3], less that passed the
+        other way (left and right looking along the polyline from its first vertex)."""
+        return self.volume_to_right - self.volume_to_left
+
     def summary(self) -> dict:
-        """The volume passed over the wall so far [m3], for run.json."""
-        return {"name": self.name, "volume_passed_m3": float(self.volume_passed)}
+        """The volumes passed over the wall so far [m3], each way, for run.json."""
+        return {"left_to_right_m3": float(self.volume_to_right),
+                "right_to_left_m3": float(self.volume_to_left)}
 
     def __repr__(self) -> str:
         return (f"Weir({self.name}, {self.pieces} pieces over {self.crest.length:g} m, "

@@ -380,8 +380,7 @@ def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
         manifest["flux_lines"] = model.flux_lines.summary()
     weirs = [b for b in model.boundaries if isinstance(b, Weir)]
     if weirs:  # the volume passed over each crest wall (floodsph.boundaries.weir)
-        manifest["walls_overtopped_m3"] = {b.name: b.summary()["volume_passed_m3"]
-                                           for b in weirs}
+        manifest["walls_overtopped_m3"] = {b.name: b.summary() for b in weirs}
     if mass is not None:
         manifest["mass_error_rel"] = mass.budget(model).error_rel
 

@@ -60,8 +60,22 @@ def preflight(scenario: Scenario, out_dir: str | Path | None = None, *,
     folder = RunFolder(out, scenario.input_files(), overwrite=overwrite, resume=resume)
     folder.check()
     inputs = prepare_inputs(scenario)
+    _check_crest_walls(scenario, inputs)
     checkpoint = _resumable(folder, scenario, inputs, threads) if resume else None
     return Preflight(folder, inputs, checkpoint)
+
+
+def _check_crest_walls(scenario: Scenario, inputs) -> None:
+    """The crests and breaches of the walls on their walls and the DEM (a breach beyond its
+    wall, a crest below the ground), as the model will build them
+    (``floodsph.model.from_scenario.weirs``)."""
+    from dataclasses import replace
+
+    from floodsph.model.from_scenario import weirs
+
+    if any(wall.crest_m is not None for wall in scenario.walls):
+        numerics = replace(scenario.numerics, particle_spacing_m=inputs.spacing_m)
+        weirs(inputs, numerics, scenario.path.name)
 
 
 def _resumable(folder: RunFolder, scenario: Scenario, inputs, threads: int | None):

@@ -109,6 +109,24 @@ def test_crest_wall_passes_water_and_run_json_counts_it(write_scenario, tmp_path
     manifest, _ = _run(write_scenario, tmp_path, 'hydrograph = "q.csv"', extra=wall)
     assert manifest["status"] == "completed"
     passed = manifest["walls_overtopped_m3"]
-    assert list(passed) == ["walls[0]"] and passed["walls[0]"] > 0.0
+    assert list(passed) == ["walls[0]"]
+    # the wall runs south to north: its right is the east, where the water goes
+    assert passed["walls[0]"]["left_to_right_m3"] > 0.0
     assert manifest["volume_domain_m3"] == pytest.approx(manifest["volume_in_m3"], rel=1e-9)
     assert manifest["mass_error_rel"] < 1e-9
+
+
+def test_check_refuses_a_breach_beyond_its_wall(write_scenario, tmp_path):
+    """``floodsph check`` (the preflight) builds the crests as the run will: a breach centred
+    beyond the end of its 200 m wall is refused before anything runs, naming the key."""
+    from floodsph.errors import InputError
+    from floodsph.run.preflight import preflight
+
+    (tmp_path / "q.csv").write_text("time_s,discharge_m3s\n0,20\n60,20\n")
+    wall = (f"\n[[walls]]\npolyline = [[{X0 + 200}, {Y0}], [{X0 + 200}, {Y0 + NY * CELL}]]\n"
+            "crest_m = 101.0\n\n[walls.breach]\ncentre_m = 250.0\ninvert_m = 100.0\n"
+            "bottom_width_m = 20.0\nformation_s = 60.0\n")
+    path = write_scenario(HEAD.format(edges="closed", source='hydrograph = "q.csv"') + wall)
+    with pytest.raises(InputError, match=r"walls\[0\]\.breach\.centre_m: 250 m is beyond the "
+                                         r"end of the wall, which is 200 m long"):
+        preflight(load_scenario(path), tmp_path / "out")
