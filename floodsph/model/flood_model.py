@@ -427,7 +427,8 @@ class FloodModel:
         num = self.numerics
         p = self.particles
         h_predicted = p.h.copy()
-        rho_predicted = p.rho.copy() if self.balanced else None
+        releasing = self.balanced and bool((p.bank_held == level_offsets.RELEASED).any())
+        rho_predicted = p.rho.copy() if releasing else None
         held = ((p.bank_held == level_offsets.HELD) | (p.bank_held == level_offsets.BANKED)
                 if self.balanced else None)
         for _ in range(SETTLE_ROUNDS if settle else 2):
@@ -448,7 +449,7 @@ class FloodModel:
             p.hgrow[:] = p.h / h_predicted
         else:
             p.hgrow[rows] = p.h[rows] / h_predicted[rows]
-        if self.balanced:
+        if rho_predicted is not None:
             level_offsets.release(p.bank_held, rho_predicted, p.rho, p.eta_offset)
         self.counters["density_unconverged"] += outcome.unconverged
         self.counters["density_capped"] += outcome.capped
