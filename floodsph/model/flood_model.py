@@ -451,6 +451,8 @@ class FloodModel:
             p.hgrow[rows] = p.h[rows] / h_predicted[rows]
         if rho_predicted is not None:
             level_offsets.release(p.bank_held, rho_predicted, p.rho, p.eta_offset)
+        if self.balanced:
+            level_offsets.floor_offsets(p.rho, p.bank_held, p.eta_offset)
         self.counters["density_unconverged"] += outcome.unconverged
         self.counters["density_capped"] += outcome.capped
         self.counters["density_held"] += outcome.held

@@ -31,9 +31,10 @@ When its level departs from its seeded level it is ``BANKED``: no longer damped 
 it keeps the rest. When it moves (``RELEASED``), the density solve takes it again, and its
 offset takes the difference between its continuity depth and its summation depth, so that
 its level does not jump (:func:`release`); from then on the offset fades as for any moving
-water. (Released to the summation depth by a change of level alone, a particle pressed
-against Malpasset's dam wall, whose summation depth is 54 m where the water is 35 m deep,
-jumped between the solve's roots and was thrown at 10 m/s.)
+water, and never takes the level below the bed (:func:`floor_offsets`). (Released to the
+summation depth by a change of level alone, a particle pressed against Malpasset's dam wall,
+whose summation depth is 54 m where the water is 35 m deep, jumped between the solve's roots
+and was thrown at 10 m/s.)
 """
 
 from __future__ import annotations
@@ -91,6 +92,17 @@ def hold_still(u, v, x, y, x_seed, y_seed, bank_held, dt, hold_time, stiffness):
         if bank_held[i] == HELD:
             u[i] = (u[i] - stiffness * (x[i] - x_seed[i]) * dt) * factor
             v[i] = (v[i] - stiffness * (y[i] - y_seed[i]) * dt) * factor
+
+
+@njit(parallel=True, cache=True)
+def floor_offsets(rho, bank_held, offset):
+    """o_i <- max(o_i, -rho_i / rho_w) [m] for the particles neither ``HELD`` nor ``BANKED``: the
+    level d + b + o of moving water never falls below the bed. A negative offset carried by
+    water that ran from a deep lake onto a shallow front would otherwise outlast the depth it
+    corrects, and leave a particle with mass a level below the ground (module docstring)."""
+    for i in prange(offset.shape[0]):
+        if bank_held[i] != HELD and bank_held[i] != BANKED:
+            offset[i] = max(offset[i], -rho[i] / RHO_WATER)
 
 
 def release(bank_held: np.ndarray, rho_continuity: np.ndarray, rho: np.ndarray,

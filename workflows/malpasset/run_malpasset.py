@@ -19,7 +19,7 @@ Results folder (default ``workflows/malpasset/results``):
 
 Usage: ``python workflows/malpasset/run_malpasset.py [--sea particles|sink|both]
 [--end-time S] [--spacing M] [--refinement MODE] [--time-stepping global|local]
-[--stabilisation lax-friedrichs|riemann|muscl] [--out DIR]
+[--stabilisation lax-friedrichs|riemann|muscl] [--momentum variational|balanced] [--out DIR]
 [--overwrite] [--max-steps N]``
 """
 
@@ -118,7 +118,7 @@ def _print(points: list[dict], costs: list[dict]) -> None:
 
 def _numerics(args) -> dict:
     """The ``[numerics]`` keys the command line sets."""
-    keys = ("refinement", "time_stepping", "stabilisation")
+    keys = ("refinement", "time_stepping", "stabilisation", "momentum")
     return {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
 
 
@@ -156,6 +156,8 @@ def main(argv=None) -> int:
                         help="numerics.time_stepping (default: floodsph's, local)")
     parser.add_argument("--stabilisation", choices=("lax-friedrichs", "riemann", "muscl"),
                         default=None, help="numerics.stabilisation (default: floodsph's)")
+    parser.add_argument("--momentum", choices=("variational", "balanced"), default=None,
+                        help="numerics.momentum (default: floodsph's)")
     parser.add_argument("--no-summary", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--write-static", action="store_true",
                         help="(re)write workflows/malpasset/scenario.toml and exit")
