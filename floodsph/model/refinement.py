@@ -43,7 +43,7 @@ which (no_merge_steps later, away from walls, fronts and bores) merge pairwise b
 0.55 - 0.7 A0 and then 1.1 - 1.4 A0, so that the seven daughters of a thinning sheet become
 two or three particles, not seven; a merged pair stays below 2 area_min < area_max, so it
 does not split again at once (the hysteresis). With these defaults
-``workflows/refinement_benchmark.py`` measured (README, one thread, kappa 1.3) 4.2 times the
+``benchmarks/refinement_benchmark.py`` measured (README, one thread, kappa 1.3) 4.2 times the
 speed of splitting alone on the sample valley and 8.6-9.0 times on Malpasset at 20 m (4.6
 times before small particles were absorbed), with max-depth maps that agree to CSI 0.993 and
 0.954;
