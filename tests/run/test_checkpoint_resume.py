@@ -148,11 +148,11 @@ def test_resume_refuses_a_checkpoint_of_another_format_and_leaves_the_run(dam_br
     scenario = dam_break()
     out = tmp_path / "run"
     assert run(scenario, out, stop_at=5)["status"] == "interrupted"
-    saved = (out / "checkpoint" / "state.pkl").read_bytes()
+    saved = (out / "checkpoint" / "state.npz").read_bytes()
     monkeypatch.setattr(checkpoint, "FORMAT", checkpoint.FORMAT + 1)
-    with pytest.raises(InputError, match=rf"state\.pkl: a checkpoint of format "
+    with pytest.raises(InputError, match=rf"state\.npz: a checkpoint of format "
                                          rf"{checkpoint.FORMAT - 1}; this floodsph reads "
                                          rf"format {checkpoint.FORMAT} only"):
         run(scenario, out, resume=True)
     assert json.loads((out / "run.json").read_text())["status"] == "interrupted"
-    assert (out / "checkpoint" / "state.pkl").read_bytes() == saved
+    assert (out / "checkpoint" / "state.npz").read_bytes() == saved
