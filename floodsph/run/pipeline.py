@@ -5,9 +5,9 @@ both call (``floodsph.run.preflight``: the run folder, with nothing that is not 
 run's and no completed run unless replaced; the inputs -- terrain, particles, hydrographs,
 inflow sides, memory -- all before the run folder is touched) -> the folder is locked and
 opened (``floodsph.log``, ``scenario.resolved.toml``, ``run.json`` with status
-``"running"``) -> ``FloodModel`` (or the one of a checkpoint) -> ``Simulation`` with the
-mass-balance, progress, recorder and checkpoint callbacks -> maps, gauges and mass balance
-(written under temporary names, then renamed) -> quick-looks and ``report.html``
+``"running"``) -> ``FloodModel`` (on resume, given the checkpoint's state) -> ``Simulation``
+with the mass-balance, progress, recorder and checkpoint callbacks -> maps, gauges and mass
+balance (written under temporary names, then renamed) -> quick-looks and ``report.html``
 (``floodsph.output.report``) -> ``run.json`` last.
 
 ``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached

@@ -80,6 +80,12 @@ def test_a_damaged_checkpoint_is_refused_with_one_message(interrupted):
     path.write_bytes(whole[: len(whole) // 2])
     with pytest.raises(InputError, match=r"state\.npz: the checkpoint cannot be read"):
         resume(scenario, out)
+    flipped = bytearray(whole)
+    flipped[len(whole) // 2] ^= 0xFF  # one byte of some array changed: its checksum fails
+    path.write_bytes(bytes(flipped))
+    with pytest.raises(InputError, match=r"state\.npz: the checkpoint cannot be read \(Bad "
+                                         r"CRC-32"):
+        resume(scenario, out)
     path.write_bytes(whole)
     with np.load(path, allow_pickle=False) as npz:
         arrays = {name: npz[name] for name in npz.files}
