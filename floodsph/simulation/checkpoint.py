@@ -170,6 +170,8 @@ def load_checkpoint(directory: Path) -> Checkpoint:
             raise InputError(f"{path}: the field {name} is not a {kind.__name__}")
     if not isinstance(tree["model"].get("t"), float):
         raise InputError(f"{path}: the field model.t is missing or not a number")
+    if not all(isinstance(row, list) for row in tree["mass_rows"]):
+        raise InputError(f"{path}: the field mass_rows is not a list of rows")
     return Checkpoint(scenario=tree[SCENARIO], threads=tree["threads"], model=tree["model"],
                       simulation=tree["simulation"], recorders=tree["recorders"],
                       mass_rows=[tuple(row) for row in tree["mass_rows"]],
