@@ -95,6 +95,10 @@ class Refiner:
         ``particle_spacing_m`` [m]: the area thresholds are multiples of spacing^2.
     """
 
+    STATE = ("last_call",)
+    """What changes during a run (``floodsph.simulation.state_arrays``): the step of the last
+    call, which the merge interval and the relaxation rate count from."""
+
     def __init__(self, numerics: Numerics):
         spacing = numerics.particle_spacing_m
         if spacing is None:
@@ -103,7 +107,7 @@ class Refiner:
         self.spacing = float(spacing)
         self.area_max = numerics.refine_area_max * self.spacing**2
         self.area_min = numerics.refine_area_min * self.spacing**2
-        self._last_call = -1  # model.steps at the last apply: merges are due every
+        self.last_call = -1  # model.steps at the last apply: merges are due every
         # refine_merge_interval steps, also when a call ends several (local time stepping)
 
     @classmethod
@@ -123,10 +127,10 @@ class Refiner:
         compounded rate of the steps since the last call (several with local time stepping).
         """
         s = self.numerics
-        steps = model.steps - self._last_call
+        steps = model.steps - self.last_call
         every = s.refine_merge_interval
-        merge_due = model.steps // every != self._last_call // every
-        self._last_call = model.steps
+        merge_due = model.steps // every != self.last_call // every
+        self.last_call = model.steps
         if not s.refinement.splits or model.particles.n == 0:
             return 0, 0
         rate = RELAX_RATE if steps == 1 else 1.0 - (1.0 - RELAX_RATE) ** steps
