@@ -43,8 +43,11 @@ import numpy as np
 
 from floodsph.api import run_scenario
 from floodsph.boundaries.crest import Crest, resolve_breach
-from floodsph.boundaries.weir import IDEAL_COEFFICIENT
+from floodsph.boundaries.weir import IDEAL_COEFFICIENT, Weir, unit_discharge
 from floodsph.breach import BreachParams, breach_hydrograph
+from floodsph.breach.formulas import progression, trapezoid_weir_discharge
+from floodsph.breach.params import resolve
+from floodsph.breach.storage import read_storage_table
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.io.hydrograph import Hydrograph
 from floodsph.io.polygons import points_in_polygon
@@ -55,6 +58,8 @@ from floodsph.simulation.schedules import TimeInterval
 
 SCENARIO = Path(__file__).resolve().parent.parent / "data_samples" / "valley_dam" / "scenario.toml"
 STORAGE_STEP_M = 0.1
+START_DISCHARGE = 1.0
+"""The outflow starts when the discharge first exceeds this [m3/s]."""
 TARGETS = {"peak": 0.10, "time": 0.10, "volume": 0.01, "balance": 0.001}
 
 
@@ -128,34 +133,53 @@ def level_pool_params(scenario, storage_csv: Path, duration_s: float) -> BreachP
         "duration_s": duration_s, "dt_s": 5.0})
 
 
-class Downstream:
-    """A callback: at each call, the water volume on the right of a straight flux line (the
-    half-plane downstream of it) from the particles, the net volume through the line so far,
-    the model's outflow so far, and the volume upstream of the dam wall (x below it)."""
+class Probe:
+    """A callback: at each call, a row of the time [s], the water volume on the right of a
+    straight flux line (the half-plane downstream of it) from the particles, the net volume
+    through the line so far, the model's outflow so far, the volume upstream of the wall
+    (x below it) [m3], and the mean level [m] of the wet particles (deeper than 1 cm) in a
+    box 40 m by 40 m upstream and downstream of the breach centre ``(xc, yc)`` (local)."""
 
-    def __init__(self, line: int, wall_x: float):
-        self.line, self.wall_x = line, wall_x
-        self.rows: list[tuple[float, float, float, float, float]] = []
+    BOX = 40.0
+    COLUMNS = ("time_s", "downstream_m3", "through_m3", "out_m3", "reservoir_m3",
+               "level_up_m", "level_down_m")
+
+    def __init__(self, line: int, wall_x: float, centre: tuple[float, float]):
+        self.line, self.wall_x, self.centre = line, wall_x, centre
+        self.rows: list[dict[str, float]] = []
 
     def __call__(self, sim) -> None:
         model = sim.model
         p = model.particles
-        ax, ay, bx, by = model.flux_lines.seg[model.flux_lines.owner == self.line][0]
+        lines = model.flux_lines
+        ax, ay, bx, by = lines.seg[lines.owner == self.line][0]
         right = (bx - ax) * (p.y - ay) - (by - ay) * (p.x - ax) < 0.0
         volume = p.m / RHO_WATER
-        lines = model.flux_lines
-        through = float(lines.forward[self.line] - lines.backward[self.line])
-        self.rows.append((float(model.t), float(np.sum(volume[right])), through,
-                          float(model.volume_out), float(np.sum(volume[p.x < self.wall_x]))))
+        depth = model.depth()
+        level = depth + model.bed[: p.n, 0]
+        xc, yc = self.centre
+        near = (np.abs(p.y - yc) < 0.5 * self.BOX) & (depth > 0.01)
+        up = near & (p.x < xc) & (p.x > xc - self.BOX)
+        down = near & (p.x > xc) & (p.x < xc + self.BOX)
+        values = (float(model.t), float(np.sum(volume[right])),
+                  float(lines.forward[self.line] - lines.backward[self.line]),
+                  float(model.volume_out), float(np.sum(volume[p.x < self.wall_x])),
+                  float(np.mean(level[up])) if up.any() else math.nan,
+                  float(np.mean(level[down])) if down.any() else math.nan)
+        self.rows.append(dict(zip(self.COLUMNS, values, strict=True)))
 
 
 def run_sample(scenario, folder: Path, interval: float):
-    """Run the scenario into ``folder``; return its run.json and the :class:`Downstream` rows
-    of the first flux line."""
+    """Run the scenario into ``folder``; return its run.json and the :class:`Probe` rows of
+    the first flux line."""
     names = [line.name for line in scenario.flux_lines]
-    wall_x = float(np.mean(np.asarray(scenario.walls[0].polyline)[:, 0]))
-    x0 = read_grid(scenario.terrain.dem, what="DEM").transform.c
-    probe = Downstream(names.index(scenario.flux_lines[0].name), wall_x - x0)
+    crest, breach = wall_breach(scenario)
+    grid = read_grid(scenario.terrain.dem, what="DEM")
+    x0, y0 = grid.transform.c, grid.transform.f - grid.shape[0] * grid.dy  # the local origin
+    xs, ys = np.asarray(scenario.walls[0].polyline).T
+    centre = (float(np.interp(breach.centre_m, crest.s, xs)) - x0,
+              float(np.interp(breach.centre_m, crest.s, ys)) - y0)
+    probe = Probe(names.index(scenario.flux_lines[0].name), float(np.mean(xs)) - x0, centre)
     started = time.monotonic()
     result = run_scenario(scenario, folder, progress=False, overwrite=True,
                           callbacks=[(probe, TimeInterval(interval))])
@@ -194,20 +218,59 @@ def compare(t_model, q_model, t_pool, q_pool, end: float, smooth_s: float) -> di
         "peak_err": float(smooth[k] / q_pool[j] - 1.0),
         "time_err": t_peak_model / float(t_pool[j]) - 1.0,
         "volume_err": volume_model / volume_pool - 1.0,
-        "smooth": smooth,
+        "smooth": smooth, "t_model": t_model, "t_pool": t_pool, "q_pool": q_pool,
+        "start_model": float(t_model[np.argmax(q_model > START_DISCHARGE)]),
+        "start_pool": float(t_pool[np.argmax(q_pool > START_DISCHARGE)]),
     }
 
 
 def balance(rows) -> dict:
     """The volume through the line against the change downstream plus the outflow, and the
-    reservoir's loss, from the first and the last :class:`Downstream` rows."""
-    t0, down0, through0, out0, up0 = rows[0]
-    t1, down1, through1, out1, up1 = rows[-1]
-    gained = (down1 - down0) + (out1 - out0)
-    through = through1 - through0
+    reservoir's loss, from the first and the last :class:`Probe` rows."""
+    first, last = rows[0], rows[-1]
+    gained = (last["downstream_m3"] - first["downstream_m3"]) + (last["out_m3"]
+                                                                  - first["out_m3"])
+    through = last["through_m3"] - first["through_m3"]
     error = gained / through - 1.0 if through else math.nan
     return {"through": through, "gained": gained, "balance_err": error,
-            "reservoir_loss": up0 - up1, "time": t1}
+            "reservoir_loss": first["reservoir_m3"] - last["reservoir_m3"],
+            "time": last["time_s"]}
+
+
+def capacities(weir: Weir, breach, setup, level: float, t: float) -> tuple[float, ...]:
+    """Free weir discharge [m3/s] at a reservoir level [m] and time t [s] of: the model's
+    wall, its law on each piece at the crest of the piece's midpoint; the wall's trapezoid
+    itself, q integrated exactly over the bottom and the sloping sides,
+    C sqrt(g) (b y^1.5 + 0.8 m y^2.5) with y the head on the bottom; and the level pool's
+    breach (``floodsph.breach.formulas.trapezoid_weir_discharge``, its own bottom and width
+    at t, sides 2.45 / 3.1 of the bottom's coefficient)."""
+    pieces = float(np.sum(weir.length * unit_discharge(level - weir.crest_now(t),
+                                                       coefficient=weir.coefficient)))
+    r = breach.fraction(t)
+    top = float(weir.crest.base(breach.centre_m))
+    y = max(level - (top - r * (top - breach.invert_m)), 0.0)
+    wall = weir.coefficient * math.sqrt(GRAVITY) * (
+        r * breach.bottom_width_m * y**1.5 + 0.8 * breach.side_slope * y**2.5)
+    p = setup.params
+    r_pool = progression((t - p.start_time_s) / setup.formation_time_s, p.progression)
+    pool = trapezoid_weir_discharge(
+        level, setup.top_m - r_pool * (setup.top_m - setup.invert_m),
+        r_pool * setup.bottom_width_m, setup.side_slope, p.weir_coefficient)
+    return pieces, wall, pool
+
+
+def levels_at(rows, when: float, storage, t_pool, q_pool, weir, breach, setup) -> dict:
+    """At the probe row nearest ``when`` [s]: the level pool's level, the level the model's
+    reservoir volume would have if flat, the mean levels by the breach upstream and
+    downstream, the breach bottom [m], and the :func:`capacities` at the level pool's level."""
+    row = min(rows, key=lambda r: abs(r["time_s"] - when))
+    t = row["time_s"]
+    released = Hydrograph(t_pool, q_pool).volume(0.0, t)
+    pool = storage.level(rows[0]["reservoir_m3"] - released)
+    return {"time": t, "pool": pool, "flat": storage.level(row["reservoir_m3"]),
+            "up": row["level_up_m"], "down": row["level_down_m"],
+            "bottom": float(weir.crest.at([breach.centre_m], t)[0]),
+            "capacity": capacities(weir, breach, setup, pool, t)}
 
 
 def still_lake(scenario, seconds: float, root: Path) -> list[dict]:
@@ -243,7 +306,56 @@ def still_lake(scenario, seconds: float, root: Path) -> list[dict]:
     return out
 
 
-def page(args, scenario, pool, summary, cmp, bal, manifest, still) -> str:
+def why(diag, cmp, spacing: float, breach) -> list[str]:
+    """The paragraph that explains the differences, with the figures of ``diag`` at the
+    model's peak: the pieces' capacity over the trapezoid's, the head by the breach over the
+    flat reservoir's, and Villemonte's factor (``docs/structures.md`` §2) for the levels by
+    the breach."""
+    d = diag["peak"]
+    pieces, trapezoid, pool = d["capacity"]
+    head_up, head_flat = d["up"] - d["bottom"], d["flat"] - d["bottom"]
+    ratio = max(d["down"] - d["bottom"], 0.0) / head_up
+    factor = (1.0 - ratio**1.5) ** 0.385
+    return [
+        "**Why they differ.** The weir law and its coefficient are the same (C sqrt(g) per "
+        "metre; the level pool's sides take Fread's 2.45 / 3.1 = 0.790 of it where the "
+        "exact integral over a 1:1 side gives 0.8), and so is the breach's bottom at every "
+        "time. What differs:",
+        "",
+        f"- *The wall's pieces.* At a {spacing:g} m spacing the wall is cut into pieces "
+        f"{spacing:g} m long, each passing the law at the crest of its midpoint: the "
+        f"{breach.bottom_width_m:.1f} m breach is a few pieces. At the peak they pass "
+        f"{pieces / trapezoid:.2f} times what the trapezoid passes at the same level "
+        f"({pieces:.0f} against {trapezoid:.0f} m3/s; the level pool's breach {pool:.0f}). "
+        "The breach centre lies on the boundary between two pieces, so a notch narrower "
+        "than a piece passes little until it has widened: the model's outflow exceeds "
+        f"{START_DISCHARGE:g} m3/s at {cmp['start_model']:.0f} s, the level pool's at "
+        f"{cmp['start_pool']:.0f} s, and by {cmp['time_pool']:.0f} s the model has released "
+        f"{100 * (1 - diag['volume_by_peak'][0] / diag['volume_by_peak'][1]):.0f} % less.",
+        "- *2-D drawdown.* The water accelerates towards the breach: at the peak the level "
+        f"by the breach stands {d['flat'] - d['up']:.2f} m below the level the reservoir "
+        f"would have at rest, a head on the bottom of {head_up:.2f} m instead of "
+        f"{head_flat:.2f} m, which passes {(head_up / head_flat) ** 1.5:.2f} times as much "
+        "by the law. The level pool takes the whole reservoir at one level; the wall reads "
+        "the level of the approaching water, and its velocity head is not counted.",
+        "- *Tailwater.* Below the breach the gorge stands "
+        f"{max(d['down'] - d['bottom'], 0.0):.2f} m above the breach bottom at the peak, "
+        f"{ratio:.2f} of the upstream head: Villemonte's factor for that is {factor:.2f}. "
+        "The wall reduces its discharge by the tailwater it reads; the level pool is free "
+        "flow always.",
+        f"- Together, {pieces / trapezoid:.2f} x {(head_up / head_flat) ** 1.5:.2f} x "
+        f"{factor:.2f} = {pieces / trapezoid * (head_up / head_flat) ** 1.5 * factor:.2f}, "
+        f"against the peaks' ratio {1 + cmp['peak_err']:.2f}: roughly, since the levels "
+        f"here are means over {Probe.BOX:g} m boxes, not the points the weir reads.",
+        "- *After the peak* the model's reservoir stands higher than the level pool's (it "
+        "has released less), so it releases more, and the volumes draw closer: "
+        f"{100 * cmp['volume_err']:+.2f} % by the end of the run. The model's hydrograph "
+        "also carries the particles' granularity (a particle crosses the line whole), "
+        "smoothed here by the running mean.",
+    ]
+
+
+def page(args, scenario, pool, summary, cmp, bal, manifest, still, diag) -> str:
     """The markdown page ``docs/breach-in-wall.md``."""
     crest, breach = wall_breach(scenario)
     top = float(crest.base(breach.centre_m))
@@ -302,6 +414,30 @@ def page(args, scenario, pool, summary, cmp, bal, manifest, still) -> str:
         "m3. Model mass error over the run "
         f"{manifest['mass_error_rel']:.1e}.",
     ]
+    by_peak = diag["volume_by_peak"]
+    lines += [
+        "",
+        "**Levels** (the model's from the particles counted every "
+        f"{args.interval:g} s: flat, the level its reservoir volume would have at rest; by "
+        f"the breach, the mean level of the water in {Probe.BOX:g} m x {Probe.BOX:g} m "
+        "boxes upstream and downstream of the breach centre):",
+        "",
+        "| time (s) | breach bottom (m) | level pool (m) | model, flat (m) "
+        "| model, by the breach upstream (m) | downstream (m) "
+        "| weir at the level pool's level (m3/s): wall's pieces / wall's trapezoid "
+        "/ level pool's breach |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+        *(f"| {d['time']:.0f} | {d['bottom']:.2f} | {d['pool']:.2f} | {d['flat']:.2f} | "
+          f"{d['up']:.2f} | {d['down']:.2f} | "
+          f"{' / '.join(f'{c:.0f}' for c in d['capacity'])} |"
+          for d in (diag["half"], diag["peak"], diag["late"])),
+        "",
+        f"By the level pool's peak ({cmp['time_pool']:.0f} s) the model had released "
+        f"{by_peak[0]:.4g} m3, the level pool {by_peak[1]:.4g} m3 "
+        f"({100 * (by_peak[0] / by_peak[1] - 1):+.1f} %).",
+        "",
+        *why(diag, cmp, spacing, breach),
+    ]
     if still:
         lines += [
             "",
@@ -312,7 +448,20 @@ def page(args, scenario, pool, summary, cmp, bal, manifest, still) -> str:
             "| --- | --- | --- | --- |",
             *(f"| {s['momentum']} | {s['speed']:.3g} | {s['stray']:.3g} | {s['passed']:.3g} |"
               for s in still),
+            "",
+            "The wall holds the water either way (nothing passes below its crest), but with "
+            "the default (variational) momentum the lake does not stay at rest behind the "
+            "straight wall in this valley: particles move at up to "
+            f"{still[0]['speed']:.2g} m/s and their levels stray by up to "
+            f"{still[0]['stray']:.2g} m. The balanced momentum holds it exactly "
+            "(docs/balanced-momentum.md), so the sample takes it.",
         ]
+    lines += ["", f"**Hydrographs** (m3/s; the model's {args.smooth:g} s running mean):", "",
+              "| time (s) | model | level pool |", "| --- | --- | --- |"]
+    for t in np.arange(600.0, args.end + 1.0, 600.0):
+        k = int(np.argmin(np.abs(cmp["t_model"] - t)))
+        lines.append(f"| {t:.0f} | {cmp['smooth'][k]:.0f} | "
+                     f"{np.interp(t, cmp['t_pool'], cmp['q_pool']):.0f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -327,6 +476,8 @@ def main(argv=None) -> None:
     ap.add_argument("--still", type=float, default=0.0, help="still-lake runs [s]; 0: none")
     ap.add_argument("--runs", type=Path, default=None, help="run folders (default: temporary)")
     ap.add_argument("--out", type=Path, default=None, help="write the markdown page here")
+    ap.add_argument("--reuse", action="store_true",
+                    help="take the runs' results from --runs (results.json) if there")
     args = ap.parse_args(argv)
 
     scenario = load_scenario(args.scenario)
@@ -346,13 +497,32 @@ def main(argv=None) -> None:
     t_pool, q_pool, summary = breach_hydrograph(params)
     full = breach_hydrograph(dataclasses.replace(params, duration_s=None))[2]
 
-    manifest, rows = run_sample(scenario, root / "sample", args.interval)
+    saved = root / "results.json"
+    if args.reuse and saved.exists():
+        results = json.loads(saved.read_text())
+    else:
+        manifest, rows = run_sample(scenario, root / "sample", args.interval)
+        still = still_lake(scenario, args.still, root) if args.still > 0 else []
+        results = {"manifest": manifest, "rows": rows, "still": still}
+        saved.write_text(json.dumps(results))
     t_model, q_model = read_flux(root / "sample", scenario.flux_lines[0].name)
     cmp = compare(t_model, q_model, t_pool, q_pool, end, args.smooth)
-    bal = balance(rows)
-    still = still_lake(scenario, args.still, root) if args.still > 0 else []
+    bal = balance(results["rows"])
+    crest, breach = wall_breach(scenario)
+    storage = read_storage_table(storage_csv, "storage")
+    weir = Weir(crest, scenario.numerics.particle_spacing_m, scenario.numerics.kappa,
+                scenario.walls[0].discharge_coefficient or IDEAL_COEFFICIENT)
+    setup = resolve(params)
+    diag = {name: levels_at(results["rows"], when, storage, t_pool, q_pool, weir, breach,
+                            setup)
+            for name, when in (("half", 0.5 * cmp["time_pool"]), ("peak", cmp["time_model"]),
+                               ("late", 0.5 * (cmp["time_model"] + end)))}
+    step = float(t_model[1] - t_model[0])
+    diag["volume_by_peak"] = (float(np.sum(q_model[t_model <= cmp["time_pool"]]) * step),
+                              Hydrograph(t_pool, q_pool).volume(0.0, cmp["time_pool"]))
+    manifest, still = results["manifest"], results["still"]
 
-    text = page(args, scenario, params, full, cmp, bal, manifest, still)
+    text = page(args, scenario, params, full, cmp, bal, manifest, still, diag)
     print(text)
     with open(root / "hydrographs.csv", "w", newline="") as f:
         w = csv.writer(f)
