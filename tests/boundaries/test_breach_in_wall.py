@@ -31,7 +31,7 @@ REACHES_WATER = START + FORMATION * (CREST - LEVEL) / (CREST - INVERT)
 SCENARIO = f"""
 [scenario]
 name = "breach-in-wall"
-end_time_s = 20.0
+end_time_s = 12.0
 
 [terrain]
 dem = "channel.tif"
@@ -71,7 +71,7 @@ formats = []
 def test_the_flux_line_counts_what_the_reservoir_loses_through_the_breach(tmp_path):
     """A 1 m deep reservoir on a flat bed behind a crest wall 0.2 m above it; below the wall
     the bed falls 3 % towards the closed east end. The breach (2 m wide at the bottom, down
-    to 5 cm above the bed) starts at 1 s and reaches the water at 1.17 s."""
+    to 5 cm above the bed) starts at 1 s and reaches the water at 1.7 s."""
     x = (np.arange(NX) + 0.5) * CELL
     bed = 100.0 - 0.03 * np.maximum(x - WALL_X, 0.0)
     write_geotiff(tmp_path / "channel.tif", np.tile(bed, (NY, 1)), cell=CELL)
@@ -105,7 +105,7 @@ def test_the_flux_line_counts_what_the_reservoir_loses_through_the_breach(tmp_pa
     # the flux line counts the water that appeared beyond it; with the water between the
     # wall and the line, that is the reservoir's loss, at every step
     assert m["flux_lines"][0]["volume_net_m3"] == pytest.approx(through[-1], rel=1e-12)
-    assert through[-1] > 0.9 * lost
+    assert through[-1] > 0.8 * lost  # most of it has crossed the line
     np.testing.assert_allclose(through, beyond, rtol=1e-9, atol=1e-9 * start)
     np.testing.assert_allclose(through + between, start - reservoir, rtol=1e-9,
                                atol=1e-9 * start)
