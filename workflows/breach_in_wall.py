@@ -23,8 +23,12 @@ The sample holds the valley's reservoir as water behind a crest wall across the 
 5. ``--still S`` also runs the reservoir at rest behind the intact wall for S seconds with
    each momentum (``docs/balanced-momentum.md``) and reports how far the level strays.
 
+The sample's spacing, 10 m, is the coarsest that runs: at 20 m the balanced momentum stops
+within the first seconds with a negative depth at the reservoir's shore, with or without the
+wall. ``--reuse`` writes the page again from the results of the runs kept in ``--runs``.
+
 Usage: ``python workflows/breach_in_wall.py [--scenario data_samples/valley_dam/scenario.toml]
-[--spacing 10] [--end 7200] [--smooth 60] [--still 600] [--runs DIR] [--out
+[--spacing 10] [--end 7200] [--smooth 60] [--still 600] [--runs DIR] [--reuse] [--out
 docs/breach-in-wall.md]``
 """
 
