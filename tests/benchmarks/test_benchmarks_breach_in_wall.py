@@ -1,4 +1,4 @@
-"""``workflows/breach_in_wall.py``: the reservoir storage it tabulates from the DEM, and the
+"""``benchmarks/breach_in_wall.py``: the reservoir storage it tabulates from the DEM, and the
 level-pool breach it maps the wall's breach onto (no model run).
 
 Facts that could fail: the storage at the lake level is the volume of water the sample seeds
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import load_workflow
+from conftest import load_script
 
 from floodsph.breach import breach_hydrograph
 from floodsph.breach.formulas import progression
@@ -24,8 +24,10 @@ from floodsph.breach.params import resolve
 from floodsph.inputs.prepare import prepare_inputs
 from floodsph.scenario.reader import load_scenario
 
-WORKFLOWS = Path(__file__).resolve().parents[2] / "workflows"
-bw = load_workflow("breach_in_wall", WORKFLOWS / "breach_in_wall.py")
+pytestmark = pytest.mark.benchmark
+
+BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+bw = load_script("breach_in_wall", BENCHMARKS / "breach_in_wall.py")
 
 
 @pytest.fixture(scope="module")

@@ -27,7 +27,7 @@ The sample's spacing, 10 m, is the coarsest that runs: at 20 m the balanced mome
 within the first seconds with a negative depth at the reservoir's shore, with or without the
 wall. ``--reuse`` writes the page again from the results of the runs kept in ``--runs``.
 
-Usage: ``python workflows/breach_in_wall.py [--scenario data_samples/valley_dam/scenario.toml]
+Usage: ``python benchmarks/breach_in_wall.py [--scenario data_samples/valley_dam/scenario.toml]
 [--spacing 10] [--end 7200] [--smooth 60] [--still 600] [--runs DIR] [--reuse] [--out
 docs/breach-in-wall.md]``
 """
@@ -371,7 +371,7 @@ def page(args, scenario, pool, summary, cmp, bal, manifest, still, diag) -> str:
     lines = [
         "# A breach in a crest-wall dam against the level-pool hydrograph",
         "",
-        "Written by `python workflows/breach_in_wall.py "
+        "Written by `python benchmarks/breach_in_wall.py "
         f"--spacing {spacing:g} --end {args.end:g} --smooth {args.smooth:g} "
         f"--still {args.still:g} --out docs/breach-in-wall.md`"
         f" ({time.strftime('%Y-%m-%d')}). The sample `data_samples/valley_dam` "
@@ -389,7 +389,7 @@ def page(args, scenario, pool, summary, cmp, bal, manifest, still, diag) -> str:
         f"when the wall's notch reaches the water ({pool.start_time_s:.0f} s), forms over "
         f"{pool.formation_time_s:.0f} s with the same bottom elevation at every time, and "
         "the weir coefficient of the wall, C sqrt(g) = "
-        f"{pool.weir_coefficient:.4f} m^0.5/s (`workflows/breach_in_wall.py`, "
+        f"{pool.weir_coefficient:.4f} m^0.5/s (`benchmarks/breach_in_wall.py`, "
         "`level_pool_params`).",
         "",
         "| quantity | model (flux line below the dam) | level pool | difference | target | met |",
