@@ -18,7 +18,7 @@ far end (the mean depth of the water within two spacings of the west wall) and r
 one period of spin-up to the end, the largest |error| against that standing wave and against
 the imposed level, and the volume balance V_0 + V_in - V_out - V [m3] over the run.
 
-Usage: ``python workflows/tide_basin.py [--length 100] [--width 10] [--spacing 2]
+Usage: ``python workflows/tide_basin.py [--length 100] [--width 10] [--spacing 2 [1 ...]]
 [--periods 2] [--out docs/level-boundary-benchmark.md]``
 """
 
@@ -116,55 +116,60 @@ def run_case(length: float, width: float, spacing: float, periods: float,
     }
 
 
-def table(row: dict) -> str:
-    return "\n".join([
+def table(rows: list[dict], command: str) -> str:
+    row = rows[0]
+    lines = [
         "# Level boundary benchmark: a tide in a closed basin",
         "",
-        "Written by `python workflows/tide_basin.py --out docs/level-boundary-benchmark.md` "
-        "(see its docstring for the set-up): a flat basin "
+        f"Written by `{command}` (see its docstring for the set-up): a flat basin "
         f"{row['length']:g} m x {row['width']:g} m (Manning n = {MANNING:g}), mean depth "
         f"{DEPTH:g} m, closed but for its east side, where the level follows "
         f"{DEPTH:g} - {AMPLITUDE:g} cos(2 pi t / {PERIOD:g} s) m from low water at rest; "
-        f"particle spacing {row['spacing']:g} m, {row['periods']:g} periods simulated on one "
-        "thread (NUMBA_NUM_THREADS=1). The far-end level is the mean depth within two "
-        "spacings of the closed west wall, sampled every 5 s; the errors are the largest over "
-        "the periods after the first (spin-up). The basin is short against the tide "
-        f"(k L = {row['kL']:.3f}), so the level is almost flat: the frictionless standing wave "
-        f"raises the far-end amplitude by the factor 1 / cos(k L) = {row['amplification']:.4f} "
-        f"({100 * (row['amplification'] - 1) * AMPLITUDE:.1f} cm) over the imposed tide.",
+        f"{row['periods']:g} periods simulated on one thread (NUMBA_NUM_THREADS=1). The "
+        "far-end level is the mean depth within two spacings of the closed west wall, sampled "
+        "every 5 s; the errors are the largest over the periods after the first (spin-up). "
+        f"The basin is short against the tide (k L = {row['kL']:.3f}), so its level is almost "
+        "flat: the frictionless standing wave raises the far-end amplitude by the factor "
+        f"1 / cos(k L) = {row['amplification']:.4f} "
+        f"({100 * (row['amplification'] - 1) * AMPLITUDE:.1f} cm) over the imposed tide. "
+        "Balance: the largest |V_0 + V_in - V_out - V| over the samples.",
         "",
-        "| quantity | value |",
-        "| --- | --- |",
-        f"| max abs error of the far-end level against the standing wave | "
-        f"{100 * row['error_wave']:.2f} cm |",
-        f"| max abs error of the far-end level against the imposed level | "
-        f"{100 * row['error_imposed']:.2f} cm |",
-        f"| initial volume V_0 | {row['volume_initial']:.3f} m3 |",
-        f"| volume in across the boundary V_in | {row['volume_in']:.3f} m3 |",
-        f"| volume out across the boundary V_out | {row['volume_out']:.3f} m3 |",
-        f"| final volume V | {row['volume_final']:.3f} m3 |",
-        f"| max abs V_0 + V_in - V_out - V over the run | {row['imbalance']:.2e} m3 |",
-        f"| particles at the end, steps | {row['particles']}, {row['steps']} |",
-        f"| wall time | {row['wall_s']:.0f} s |",
-    ]) + "\n"
+        "| spacing [m] | far-end error vs standing wave | vs imposed level | V_0 [m3] | "
+        "V_in [m3] | V_out [m3] | V [m3] | balance [m3] | particles | steps | wall [s] |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['spacing']:g} | {100 * r['error_wave']:.2f} cm | "
+            f"{100 * r['error_imposed']:.2f} cm | {r['volume_initial']:.3f} | "
+            f"{r['volume_in']:.3f} | {r['volume_out']:.3f} | {r['volume_final']:.3f} | "
+            f"{r['imbalance']:.2e} | {r['particles']} | {r['steps']} | {r['wall_s']:.0f} |")
+    return "\n".join(lines) + "\n"
 
 
-def main(argv=None) -> dict:
+def main(argv=None) -> list[dict]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--length", type=float, default=100.0)
     parser.add_argument("--width", type=float, default=10.0)
-    parser.add_argument("--spacing", type=float, default=2.0)
+    parser.add_argument("--spacing", type=float, nargs="+", default=[2.0])
     parser.add_argument("--periods", type=float, default=2.0)
     parser.add_argument("--out", type=Path, default=None)
     args = parser.parse_args(argv)
-    row = run_case(args.length, args.width, args.spacing, args.periods)
-    print(f"far-end level: max |error| {100 * row['error_wave']:.2f} cm against the standing "
-          f"wave, {100 * row['error_imposed']:.2f} cm against the imposed level; volume "
-          f"imbalance {row['imbalance']:.2e} m3; {row['wall_s']:.0f} s", flush=True)
+    rows = []
+    for spacing in args.spacing:
+        row = run_case(args.length, args.width, spacing, args.periods)
+        print(f"spacing {spacing:g} m: far-end level max |error| {100 * row['error_wave']:.2f} "
+              f"cm against the standing wave, {100 * row['error_imposed']:.2f} cm against the "
+              f"imposed level; volume imbalance {row['imbalance']:.2e} m3; "
+              f"{row['wall_s']:.0f} s", flush=True)
+        rows.append(row)
     if args.out is not None:
-        args.out.write_text(table(row), encoding="utf-8")
+        spacings = " ".join(f"{s:g}" for s in args.spacing)
+        command = (f"python workflows/tide_basin.py --spacing {spacings} --out "
+                   f"{args.out.as_posix()}")
+        args.out.write_text(table(rows, command), encoding="utf-8")
         print(f"wrote {args.out}")
-    return row
+    return rows
 
 
 if __name__ == "__main__":

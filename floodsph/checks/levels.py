@@ -6,6 +6,9 @@ coordinates and its inward unit normal (towards the modelled water). Refused: a 
 end point off the DEM rectangle, or shorter than half the particle spacing; the side of a
 line is decided as for an inflow (``floodsph.checks.inflows.inward_normal``).
 
+Refused too: a level file's level beyond +-``ELEVATION_LIMIT_M`` (a constant ``level_m`` is
+checked by the reader).
+
 Warned of (a falling tide may be meant, a datum error is more likely): a series whose highest
 level lies below the bed all along the section, so that the boundary never holds water and
 only lets water out, as over a free overfall.
@@ -17,6 +20,7 @@ import math
 
 import numpy as np
 
+from floodsph.checks.elevation import ELEVATION_LIMIT_M
 from floodsph.checks.inflows import ground, inward_normal
 from floodsph.errors import InputError, warn
 
@@ -74,6 +78,12 @@ def check_level_boundaries(scenario, terrain, series, spacing: float, source: st
     stays below the bed all along its section."""
     for i, (entry, levels) in enumerate(zip(scenario.level_boundaries, series, strict=True)):
         where = f"{source}: level_boundaries[{i}]"
+        beyond = np.abs(levels.level) > ELEVATION_LIMIT_M
+        if beyond.any():
+            raise InputError(f"{where}.file: {entry.file}: level_m = "
+                             f"{levels.level[beyond][0]:g} m (at time_s = "
+                             f"{levels.t[beyond][0]:g}) is beyond +-{ELEVATION_LIMIT_M:g} m, "
+                             "no water surface on Earth")
         line, normal = level_section(entry, terrain, spacing, where)
         bed = lowest_bed(line, normal, terrain, spacing)
         if levels.highest() <= bed:

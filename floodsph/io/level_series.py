@@ -3,7 +3,7 @@
 The CSV (``docs/level-boundary.md``) has a header line naming the columns ``time_s`` (seconds
 from the start of the run) and ``level_m`` (the water-surface elevation [m], in the DEM's
 vertical datum), in any order; other columns are ignored and blank lines skipped. Times must
-increase strictly and levels lie within +-``ELEVATION_LIMIT_M``.
+increase strictly (the levels' range is checked with the section, ``floodsph.checks.levels``).
 
 Between rows the level is linear in time; before the first row and after the last it is held
 at the first and last level (a tide table that ends early keeps its last level rather than
@@ -16,7 +16,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from floodsph.checks.elevation import ELEVATION_LIMIT_M
 from floodsph.errors import InputError
 from floodsph.io.hydrograph import read_csv_columns
 
@@ -67,9 +66,8 @@ def read_level_series(path, name: str) -> LevelSeries:
     Raises
     ------
     InputError
-        A missing file or column, a value that is no number, fewer than one row, times that
-        do not increase strictly, or a level beyond +-``ELEVATION_LIMIT_M``; the message names
-        the key, the file and the line.
+        A missing file or column, a value that is no number, fewer than one row or times
+        that do not increase strictly; the message names the key, the file and the line.
     """
     values, lines = read_csv_columns(path, name, (TIME_COLUMN, LEVEL_COLUMN))
     t, level = values[TIME_COLUMN], values[LEVEL_COLUMN]
@@ -80,8 +78,4 @@ def read_level_series(path, name: str) -> LevelSeries:
         if t[k] <= t[k - 1]:
             raise InputError(f"{name}: {path}, line {lines[k]}: {TIME_COLUMN} = {t[k]:g} does "
                              f"not follow {t[k - 1]:g}; times must increase strictly")
-    for k in range(t.size):
-        if abs(level[k]) > ELEVATION_LIMIT_M:
-            raise InputError(f"{name}: {path}, line {lines[k]}: {LEVEL_COLUMN} = {level[k]:g} "
-                             f"m is beyond +-{ELEVATION_LIMIT_M:g} m, no water surface on Earth")
     return LevelSeries(t, level)

@@ -9,6 +9,7 @@ level rises and falls; the level series is read and refused as documented.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -63,7 +64,7 @@ def test_level_series_is_linear_between_rows_and_held_beyond_them(tmp_path):
     ("time_s,level_m\n0,1\n10,1.2\n10,1.3\n", r"line 4: time_s = 10 does not follow 10"),
     ("time_s,stage\n0,1\n", r"missing column 'level_m'"),
     ("time_s,level_m\n", r"no rows"),
-    ("time_s,level_m\n0,20000\n", r"line 2: level_m = 20000 m is beyond"),
+    ("time_s,level_m\n0,1\nten,2\n", r"line 3: time_s = 'ten' is not a number"),
 ])
 def test_level_series_refuses_bad_files(tmp_path, text, match):
     path = tmp_path / "bad.csv"
@@ -87,6 +88,16 @@ def test_a_line_off_the_dem_is_refused_and_a_border_line_faces_the_dem():
     border = LevelEntry(name="sea", line=((40.0, 0.0), (40.0, 10.0)))
     _, normal = level_section(border, terrain, DX, "level_boundaries[0]")
     assert normal == pytest.approx([-1.0, 0.0])
+
+
+def test_a_level_beyond_any_water_surface_is_refused():
+    class Entries:
+        level_boundaries = (LevelEntry(name="sea", side="east", file=Path("tide.csv")),)
+
+    with pytest.raises(InputError, match=r"level_boundaries\[0\]\.file: tide\.csv: level_m = "
+                                         r"20000 m \(at time_s = 5\) is beyond"):
+        check_level_boundaries(Entries, _flat(40, 10), [LevelSeries([0.0, 5.0], [1.0, 2e4])],
+                               DX, "s.toml", None)
 
 
 def test_a_level_below_the_bed_all_along_is_warned_of():
