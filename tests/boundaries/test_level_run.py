@@ -52,6 +52,20 @@ def test_level_boundary_keys_are_refused_with_the_key_named(write_scenario, tmp_
         load_scenario(path)
 
 
+def test_the_resolved_scenario_keeps_the_level_boundaries(write_scenario, tmp_path):
+    from floodsph.scenario.writer import write_resolved
+
+    line = (f'\n[[level_boundaries]]\nname = "river"\nline = [[{X0 + 300}, {Y0}], '
+            f'[{X0 + 300}, {Y0 + 50}]]\ndirection = [-1.0, 0.0]\nlevel_m = 100.2\n')
+    scenario = load_scenario(_scenario(write_scenario, tmp_path, SEA + line))
+    (tmp_path / "copy").mkdir()
+    write_resolved(scenario, tmp_path / "copy" / "resolved.toml")
+    again = load_scenario(tmp_path / "copy" / "resolved.toml")
+    assert again.level_boundaries == scenario.level_boundaries
+    assert again.level_boundaries[1].line == ((X0 + 300, Y0), (X0 + 300, Y0 + 50))
+    assert scenario.level_boundaries[0].file == tmp_path / "tide.csv"
+
+
 def test_a_side_both_closed_and_a_level_boundary_is_refused(write_scenario):
     head = BASE_SCENARIO.replace('edges = "closed"', 'edges = "open"\nclosed_sides = ["east"]')
     path = write_scenario(head + '\n[[level_boundaries]]\nname = "sea"\nside = "east"\n'
