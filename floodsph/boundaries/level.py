@@ -5,19 +5,20 @@ segment A-B of length L with inward unit normal n, cut into N = round(L / dx) co
 dx_l = L / N; s is the distance along n (s < 0 behind the line), tau the distance along it.
 
 Boundary state per column (``floodsph.boundaries.riemann.level_state``): the imposed depth
-d_0 = eta(t) - z_k over the bed z_k of column k and the interior water between h and h + 2 dx
-inside the line give d_B and the normal velocity w_B by the outgoing Riemann invariant; w_B > 0
+d_0 = eta(t) - z_k over the bed z_k of column k and the interior water within two spacings
+of the line give d_B and the normal velocity w_B by the outgoing Riemann invariant; w_B > 0
 where water enters.
 
 Behind the line lies a buffer of ghost particles, down to the kernel reach 2 h (1 + skin). Each
 moves along n at its column's w_B and carries rho = rho_w d_B, m = rho A for its area A, its
 own h and alpha / rho, and the interior's normal velocity w_I n (the level is imposed, the
-velocity continued with a zero gradient: ``LevelBoundary.add_ghosts``). Water and buffer
-trade places:
+velocity continued with a zero gradient: ``LevelBoundary.add_ghosts``; w_B where the interior
+is dry). Water and buffer trade places:
 
 * a buffer particle that crosses the line (s >= 0) becomes water of mass rho_w d_B A, added to
-  ``volume_in``; entering columns are refilled behind with rows of spacing dx (area dx_l dx,
-  h = kappa sqrt(dx_l dx), the lattice's alpha: ``floodsph.boundaries.inflow``);
+  ``volume_in``, with its velocity; entering columns are refilled behind with rows of
+  spacing dx (area dx_l dx, h = kappa sqrt(dx_l dx), the lattice's alpha:
+  ``floodsph.boundaries.inflow``);
 * water that crosses the line (s < 0) leaves: m / rho_w is added to ``volume_out`` and the
   particle joins the buffer, which so continues the water's own spacing, as the departed
   particles do at an open edge (``floodsph.boundaries.open_edges``).
@@ -161,7 +162,9 @@ class LevelBoundary:
 
     def _inject(self, model) -> None:
         """Buffer particles that crossed the line (s >= 0) become water of depth d_B, mass
-        rho_w d_B A [kg] for their area A, counted in ``volume_in``."""
+        rho_w d_B A [kg] for their area A, counted in ``volume_in``, with the velocity they
+        had as ghosts (entering at w_B instead, the far-end error of the tide benchmark was
+        3.3 cm rather than 2.2 cm at a 2 m spacing)."""
         b = self.buffer
         crossed = b["s"] >= 0.0
         if not crossed.any():
@@ -174,7 +177,7 @@ class LevelBoundary:
         y = self.a[1] + tau * self.tangent[1] + s * self.normal[1]
         rho = RHO_WATER * self.d_b[col]
         m = rho * b["area"][crossed][wet]
-        w = self.w_b[col]
+        w = self.w_i[col]
         model.particles.append(x=x, y=y, u=w * self.normal[0], v=w * self.normal[1], m=m,
                                rho=rho, h=b["h"][crossed][wet], born=model.steps)
         volume = float(m.sum()) / RHO_WATER
@@ -218,8 +221,9 @@ class LevelBoundary:
 
     def _update_state(self, model, t: float) -> None:
         """(d_B, w_B) per column from eta(t) and the interior water: the particles within
-        ``INTERIOR_BAND`` spacings inside the line, and w_I, their mean normal velocity,
-        which the ghosts carry (``add_ghosts``)."""
+        ``INTERIOR_BAND`` spacings inside the line; and the normal velocity the ghosts and
+        the water entering carry (``add_ghosts``): w_I, their mean, or w_B where the
+        interior is dry."""
         p = model.particles
         s, tau = self._coordinates(p.x, p.y)
         near = ((s > 0.0) & (s < INTERIOR_BAND * self.dx_n) & (tau >= 0.0)
@@ -234,7 +238,7 @@ class LevelBoundary:
         w_i = np.where(wet, w_sum / np.maximum(count, 1), 0.0)
         self.level = self.series.at(t)
         self.d_b, self.w_b = level_state(self.level - self.bed, d_i, w_i)
-        self.w_i = w_i
+        self.w_i = np.where(wet, w_i, self.w_b)
 
     def add_ghosts(self, model) -> None:
         """Append the buffer particles of the columns with water (d_B > 0) as ghosts.
@@ -243,8 +247,8 @@ class LevelBoundary:
         gradient, as at an open edge), while the buffer moves at w_B: ghosts with the
         velocity w_B drag the water next to the line, whose w_I then follows w_B, and the
         invariant adds 2 (c_0 - c_I) to w_B step after step; in the tide benchmark the
-        far-end error was 3.8 cm at a 2 m spacing but 10.7 cm at 1 m so, against 3.3 and
-        5.0 cm (``docs/level-boundary-benchmark.md``).
+        far-end error was 3.8 cm at a 2 m spacing but 10.7 cm at 1 m so (with w_I:
+        ``docs/level-boundary-benchmark.md``).
         """
         b = self.buffer
         col = self._column(b["tau"])
