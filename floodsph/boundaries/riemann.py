@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from floodsph.constants import GRAVITY
 
 SUBCRITICAL = "subcritical"
@@ -91,3 +93,40 @@ def _root(q: float, invariant: float, d_c: float) -> float:
             return new
         d = new
     return d
+
+
+def level_state(d_0: np.ndarray, d_i: np.ndarray, w_i: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Depth d_B [m] and inward normal velocity w_B [m/s] where a water level is imposed.
+
+    ``d_0`` is the imposed depth, level minus bed [m] (0 where the level is below the bed);
+    ``d_i`` and ``w_i`` the interior depth [m] (0 where dry) and velocity along the inward
+    normal [m/s]; all arrays of one value per boundary column. Cases, in order:
+
+    * d_0 = 0: no water at the boundary, d_B = w_B = 0 (interior water that reaches the line
+      leaves as over a free overfall);
+    * dry interior: the boundary water spreads onto the dry bed as Ritter's dam break, whose
+      state at the dam is critical: d_B = 4 d_0 / 9, w_B = 2 sqrt(g d_0) / 3 (Stoker, Water
+      waves, 1957, section 10.6);
+    * subcritical: d_B = d_0 and, from the outgoing invariant (1),
+      w_B = w_I - 2 sqrt(g d_I) + 2 sqrt(g d_0), positive when water enters;
+    * that w_B supercritical inwards (w_B >= sqrt(g d_0)): both characteristics enter, the
+      boundary passes the critical flow from water at rest at level d_0, as in the dry case;
+    * that w_B supercritical outwards (w_B <= -sqrt(g d_0)): both characteristics leave, the
+      boundary takes the interior state, d_B = d_I, w_B = w_I.
+    """
+    d_0 = np.maximum(np.asarray(d_0, dtype=np.float64), 0.0)
+    d_i = np.asarray(d_i, dtype=np.float64)
+    w_i = np.asarray(w_i, dtype=np.float64)
+    c_0 = np.sqrt(GRAVITY * d_0)
+    w_sub = w_i - 2.0 * np.sqrt(GRAVITY * np.maximum(d_i, 0.0)) + 2.0 * c_0
+    d_b = d_0.copy()
+    w_b = w_sub
+    critical = (d_i <= 0.0) | (w_sub >= c_0)
+    d_b = np.where(critical, 4.0 / 9.0 * d_0, d_b)
+    w_b = np.where(critical, 2.0 / 3.0 * c_0, w_b)
+    leaving = ~critical & (w_sub <= -c_0)
+    d_b = np.where(leaving, d_i, d_b)
+    w_b = np.where(leaving, w_i, w_b)
+    dry = d_0 <= 0.0
+    return np.where(dry, 0.0, d_b), np.where(dry, 0.0, w_b)

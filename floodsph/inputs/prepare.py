@@ -36,6 +36,7 @@ import numpy as np
 from rasterio.crs import CRS
 
 from floodsph.checks.inflows import check_inflows
+from floodsph.checks.levels import check_level_boundaries
 from floodsph.checks.placement import check_geometry_on_dem
 from floodsph.checks.water import check_has_water, dry_body_reason
 from floodsph.errors import InputError
@@ -71,7 +72,9 @@ class Inputs:
     were converted from (hydrographs in hours or cubic feet per second, dates), one sentence
     per file. ``wall_entries`` are the ``[[walls]]`` entries
     (``floodsph.scenario.config.Wall``, their crest and breach), one per polyline of
-    ``walls``.
+    ``walls``. ``level_boundaries`` are the ``[[level_boundaries]]`` entries (lines in the
+    terrain's CRS) and ``level_series`` their levels
+    (:class:`~floodsph.io.level_series.LevelSeries`), one per entry.
     """
 
     terrain: Terrain
@@ -91,6 +94,8 @@ class Inputs:
     conversions: list[str] = field(default_factory=list)
     flux_lines: list[tuple[str, np.ndarray]] = field(default_factory=list)
     wall_entries: tuple = ()
+    level_boundaries: tuple = ()
+    level_series: list = field(default_factory=list)
 
 
 def prepare_inputs(scenario: Scenario) -> Inputs:
@@ -125,8 +130,11 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
     wet = wet_cells(terrain, walled=tc.nodata_walled)
     dry: list[str] = []
     depth = initial_depth(scenario, terrain, wet, dry)
-    check_has_water(scenario, dry, bool(np.any(depth > 0.0)), v_in, source, warnings)
+    levels = level_series(scenario)
+    check_has_water(scenario, dry, bool(np.any(depth > 0.0)) or bool(levels), v_in, source,
+                    warnings)
     check_inflows(scenario, terrain, depth, spacing, source, warnings)
+    check_level_boundaries(scenario, terrain, levels, spacing, source, warnings)
     out_cells = output_cells(scenario, terrain.shape, terrain.dx, terrain.dy)
     n_wet = np.count_nonzero(depth > 0.0) * terrain.dx * terrain.dy / spacing / spacing
     lattice = lattice_cells(terrain.width, terrain.height, spacing)
@@ -134,7 +142,7 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
                            lattice, read), source)
 
     particles = seed_particles(terrain, depth, spacing, scenario.numerics.kappa, wet=wet)
-    if particles.n == 0 and v_in <= 0.0:
+    if particles.n == 0 and v_in <= 0.0 and not levels:
         raise InputError(
             f"{source}: numerics.particle_spacing_m: the initial water seeds no particles at a "
             f"spacing of {spacing:g} m (its depth averaged over lattice cells of that size "
@@ -171,7 +179,24 @@ def prepare_inputs(scenario: Scenario) -> Inputs:
         flux_lines=[(line.name, local_points(terrain, line.polyline))
                     for line in scenario.flux_lines],
         wall_entries=tuple(scenario.walls),
+        level_boundaries=scenario.level_boundaries,
+        level_series=levels,
     )
+
+
+def level_series(scenario: Scenario) -> list:
+    """One :class:`~floodsph.io.level_series.LevelSeries` per ``[[level_boundaries]]``: its
+    constant ``level_m``, or its CSV ``file`` read."""
+    from floodsph.io.level_series import LevelSeries, read_level_series
+
+    source = scenario.path.name
+    out = []
+    for i, entry in enumerate(scenario.level_boundaries):
+        if entry.level_m is not None:
+            out.append(LevelSeries.constant(entry.level_m))
+        else:
+            out.append(read_level_series(entry.file, f"{source}: level_boundaries[{i}].file"))
+    return out
 
 
 def local_points(terrain, points) -> np.ndarray:

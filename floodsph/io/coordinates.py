@@ -121,6 +121,14 @@ def inline_to_model(scenario, terrain):
                 direction=_direction(terrain, inflow.line, inflow.direction,
                                      f"{source}: inflows[{i}].direction"))
         for i, inflow in enumerate(scenario.inflows))
+    levels = tuple(
+        entry if entry.line is None else
+        replace(entry,
+                line=_tuple(to_model(terrain, entry.line,
+                                     f"{source}: level_boundaries[{i}].line")),
+                direction=_direction(terrain, entry.line, entry.direction,
+                                     f"{source}: level_boundaries[{i}].direction"))
+        for i, entry in enumerate(scenario.level_boundaries))
     return replace(
         scenario,
         initial_water=move(scenario.initial_water, "initial_water", "polygon"),
@@ -128,4 +136,5 @@ def inline_to_model(scenario, terrain):
         sinks=move(scenario.sinks, "sinks", "polygon"),
         flux_lines=move(scenario.flux_lines, "flux_lines", "polyline"),
         inflows=inflows,
+        level_boundaries=levels,
     )

@@ -38,7 +38,7 @@ from floodsph.walls.nodata import settle_seeds
 
 def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, walls=(),
                  closed_sides: Iterable[str] = OPEN_SIDES, boundaries=(),
-                 refiner=None, held=None) -> FloodModel:
+                 refiner=None, held=None, level_sides: Iterable[str] = ()) -> FloodModel:
     """A FloodModel ready for its first step (module docstring).
 
     Parameters
@@ -62,6 +62,10 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
     refiner : floodsph.model.refinement.Refiner or None
     held : (ny, nx) bool array or None
         The DEM cells that held water at seeding (``FloodModel``).
+    level_sides : collection of str
+        The sides taken by level boundaries (``floodsph.boundaries.level``, among
+        ``boundaries``): neither walls nor open edges; the closed sides that meet them run on
+        beyond them, as beyond an open side.
     """
     if numerics.particle_spacing_m is None:
         raise ValueError("set_up_model: numerics.particle_spacing_m must be given (the "
@@ -71,8 +75,12 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
     unknown = closed - set(OPEN_SIDES)
     if unknown or isinstance(closed_sides, str):
         raise ValueError(f"closed_sides: unknown sides {sorted(unknown)}; use {OPEN_SIDES}")
+    levels = frozenset(level_sides)
+    if levels & closed or levels - set(OPEN_SIDES):
+        raise ValueError(f"level_sides: {sorted(levels)} must be sides of {OPEN_SIDES} that "
+                         "are not closed")
     boundaries = list(boundaries)
-    open_sides = [side for side in OPEN_SIDES if side not in closed]
+    open_sides = [side for side in OPEN_SIDES if side not in closed | levels]
     if open_sides:
         boundaries.insert(0, OpenEdges(terrain.width, terrain.height, open_sides))
     openings = [b.opening for b in boundaries if b.opening is not None]

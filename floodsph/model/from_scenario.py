@@ -10,11 +10,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from floodsph.boundaries import Inflow, Sink
+from floodsph.boundaries import Inflow, LevelBoundary, Sink
 from floodsph.boundaries.crest import Crest, check_crest_above_bed, resolve_breach
 from floodsph.boundaries.open_edges import SIDES
 from floodsph.boundaries.protocol import Boundary
 from floodsph.boundaries.weir import IDEAL_COEFFICIENT, Weir, bed_at
+from floodsph.checks.levels import level_section
 from floodsph.model.builder import set_up_model
 from floodsph.model.refinement import Refiner
 from floodsph.scenario.config import Edges, Scenario
@@ -35,10 +36,11 @@ def build_model(scenario: Scenario, inputs):
         inputs.particles,
         numerics,
         walls=inputs.walls,
-        closed_sides=_closed_sides(scenario.terrain),
+        closed_sides=_closed_sides(scenario),
         boundaries=open_boundaries(scenario, inputs, numerics),
         refiner=Refiner.of(numerics),
         held=inputs.depth > 0.0,
+        level_sides=_level_sides(scenario),
     )
     if inputs.flux_lines:
         from floodsph.simulation.flux import FluxLines
@@ -47,17 +49,23 @@ def build_model(scenario: Scenario, inputs):
     return model
 
 
-def _closed_sides(terrain) -> frozenset[str]:
+def _closed_sides(scenario: Scenario) -> frozenset[str]:
     """``set_up_model(closed_sides=...)``: the sides of the DEM kept closed, all four when
-    ``terrain.edges = "closed"``."""
-    if terrain.edges is Edges.CLOSED:
-        return frozenset(SIDES)
-    return frozenset(terrain.closed_sides)
+    ``terrain.edges = "closed"``, less the sides of level boundaries."""
+    terrain = scenario.terrain
+    closed = SIDES if terrain.edges is Edges.CLOSED else terrain.closed_sides
+    return frozenset(closed) - _level_sides(scenario)
+
+
+def _level_sides(scenario: Scenario) -> frozenset[str]:
+    """The sides of the DEM taken by ``[[level_boundaries]]``."""
+    return frozenset(b.side for b in scenario.level_boundaries if b.side is not None)
 
 
 def open_boundaries(scenario: Scenario, inputs, numerics) -> list[Boundary]:
-    """The ``[[inflows]]`` sections (``inputs.inflows``, in the terrain's CRS) and ``[[sinks]]``
-    polygons (``inputs.sinks``, inline or from vector files) as model boundaries."""
+    """The ``[[inflows]]`` sections (``inputs.inflows``, in the terrain's CRS), ``[[sinks]]``
+    polygons (``inputs.sinks``, inline or from vector files), crest walls and
+    ``[[level_boundaries]]`` as model boundaries."""
     terrain = inputs.terrain
     source = scenario.path.name
     out: list[Boundary] = []
@@ -70,6 +78,21 @@ def open_boundaries(scenario: Scenario, inputs, numerics) -> list[Boundary]:
     for polygon in inputs.sinks:
         out.append(Sink(polygon, terrain, reach))
     out.extend(weirs(inputs, numerics, source))
+    out.extend(level_boundaries(inputs, numerics, source))
+    return out
+
+
+def level_boundaries(inputs, numerics, source: str) -> list[LevelBoundary]:
+    """The ``[[level_boundaries]]`` (``inputs.level_boundaries``, lines in the terrain's CRS)
+    with their level series, sections checked on the DEM (``floodsph.checks.levels``)."""
+    terrain = inputs.terrain
+    out = []
+    for i, (entry, series) in enumerate(zip(inputs.level_boundaries, inputs.level_series,
+                                            strict=True)):
+        line, normal = level_section(entry, terrain, numerics.particle_spacing_m,
+                                     f"{source}: level_boundaries[{i}]")
+        out.append(LevelBoundary(line, normal, series, numerics.particle_spacing_m,
+                                 numerics.kappa, terrain, name=entry.name))
     return out
 
 

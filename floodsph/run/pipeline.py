@@ -366,7 +366,7 @@ def _save(sim, scenario, threads, manifest, mass, recorders, work, wall_start) -
 
 
 def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
-    from floodsph.boundaries import Inflow, Weir
+    from floodsph.boundaries import Inflow, LevelBoundary, Weir
 
     manifest["finished"] = now_iso()
     manifest["wall_time_s"] = wall_time
@@ -392,6 +392,9 @@ def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
     weirs = [b for b in model.boundaries if isinstance(b, Weir)]
     if weirs:  # the volume passed over each crest wall (floodsph.boundaries.weir)
         manifest["walls_overtopped_m3"] = {b.name: b.summary() for b in weirs}
+    levels = [b for b in model.boundaries if isinstance(b, LevelBoundary)]
+    if levels:  # what entered and left at each imposed level (floodsph.boundaries.level)
+        manifest["level_boundaries"] = {b.name: b.summary() for b in levels}
     if mass is not None:
         manifest["mass_error_rel"] = mass.budget(model).error_rel
 
@@ -399,19 +402,24 @@ def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
 def outflow_summary(model) -> dict:
     """``volume_out_m3`` by where the water left [m3]: ``volume_out_sinks_m3`` (one per sink,
     in the order of ``[[sinks]]`` and the features of their files), ``volume_out_sides_m3``
-    (per open side of the DEM) and ``volume_out_other_m3`` (off the grid or into nodata
-    elsewhere); together they make ``volume_out_m3``."""
-    from floodsph.boundaries import Sink
+    (per open side of the DEM), ``volume_out_levels_m3`` (per level boundary, by name) and
+    ``volume_out_other_m3`` (off the grid or into nodata elsewhere); together they make
+    ``volume_out_m3``."""
+    from floodsph.boundaries import LevelBoundary, Sink
     from floodsph.boundaries.open_edges import OpenEdges
 
     sides: dict[str, float] = {}
+    levels: dict[str, float] = {}
     sinks = []
     for boundary in getattr(model, "boundaries", ()):
         if isinstance(boundary, OpenEdges):
             sides.update(boundary.volume_out_sides)
         elif isinstance(boundary, Sink):
             sinks.append(float(boundary.volume_out))
+        elif isinstance(boundary, LevelBoundary):
+            levels[boundary.name] = float(boundary.volume_out)
     return {"volume_out_sinks_m3": sinks, "volume_out_sides_m3": sides,
+            "volume_out_levels_m3": levels,
             "volume_out_other_m3": float(getattr(model, "volume_out_other", 0.0))}
 
 

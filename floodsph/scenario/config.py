@@ -176,6 +176,26 @@ class Inflow:
 
 
 @dataclass(frozen=True)
+class LevelBoundary:
+    """``[[level_boundaries]]``: a section where the water level follows a given series
+    (``floodsph.boundaries.level``, ``docs/level-boundary.md``).
+
+    ``name`` labels it in run.json; ``side`` is a side of the DEM rectangle, or ``line`` two
+    points on the DEM (model CRS) with the optional ``direction`` [dx, dy] pointing to the
+    modelled water (by default towards lower ground, as for an inflow); the level is the
+    constant ``level_m`` [m] or the ``time_s,level_m`` CSV ``file``
+    (``floodsph.io.level_series``).
+    """
+
+    name: str
+    side: str | None = None
+    line: tuple[Point, Point] | None = None
+    direction: Point | None = None
+    level_m: float | None = None
+    file: Path | None = None
+
+
+@dataclass(frozen=True)
 class Sink:
     """``[[sinks]]``: a polygon where water leaves the model (counted as outflow), or the
     polygons of a vector ``file`` (+ ``layer``, ``crs``; see InitialWater)."""
@@ -244,6 +264,7 @@ class Scenario:
     walls: tuple[Wall, ...] = ()
     inflows: tuple[Inflow, ...] = ()
     sinks: tuple[Sink, ...] = ()
+    level_boundaries: tuple[LevelBoundary, ...] = ()
     gauges: Gauges | None = None
     flux_lines: tuple[FluxLine, ...] = ()
     numerics: Numerics = Numerics()
@@ -289,6 +310,7 @@ class Scenario:
                  *(entry.file for entry in self.walls),
                  *(entry.file for entry in self.sinks),
                  *(i.hydrograph for i in self.inflows),
+                 *(b.file for b in self.level_boundaries),
                  None if self.gauges is None else self.gauges.file]
         return tuple(f for f in files if f is not None)
 
@@ -346,6 +368,7 @@ TOP_KEYS = (
     "walls",
     "inflows",
     "sinks",
+    "level_boundaries",
     "gauges",
     "flux_lines",
     "numerics",

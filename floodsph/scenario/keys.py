@@ -30,6 +30,7 @@ from floodsph.scenario.config import (
     Gauges,
     Inflow,
     InitialWater,
+    LevelBoundary,
     OutputConfig,
     OutputFormat,
     ScenarioInfo,
@@ -304,6 +305,23 @@ SINKS = TableDoc("sinks", True, "Areas where water leaves the model (the sea, a 
     *VECTOR_KEYS,
 ))
 
+LEVEL_BOUNDARIES = TableDoc("level_boundaries", True, "A section where the water level is "
+                            "imposed (the sea, a river stage): water enters or leaves across it "
+                            "with the level (docs/level-boundary.md).", LevelBoundary, keys=(
+    KeyDoc("name", "string", "Labels the boundary in run.json (unique).", required=True),
+    KeyDoc("side", "string", "A side of the DEM (`west`, `east`, `south`, `north`), neither in "
+           "terrain.closed_sides nor taken by another level boundary. Give this or line.",
+           absent="none"),
+    KeyDoc("line", POINTS, "Instead of side: the section's two end points, on the DEM.", "m",
+           absent="none"),
+    KeyDoc("direction", "[dx, dy]", "With line: a direction pointing to the modelled water.",
+           absent="normal to line, towards lower ground (onto the DEM at its border)"),
+    KeyDoc("level_m", "number", "A constant water level. Give this or file.", "m",
+           absent="none"),
+    KeyDoc("file", "path", "CSV with columns time_s and level_m: the level, linear in time "
+           "between rows, held at the first and last level outside them.", absent="none"),
+))
+
 GAUGES = TableDoc("gauges", False, "Time series of depth, level and speed at points "
                   "(written to gauges.csv).", Gauges, keys=(
     KeyDoc("file", "path", "CSV with columns id, x, y (the DEM file's CRS, or scenario.crs), "
@@ -405,5 +423,6 @@ OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into i
 ))
 
 TABLES: tuple[TableDoc, ...] = (SCENARIO, TERRAIN, INITIAL_WATER, WALLS, WALL_BREACH, INFLOWS,
-                                BREACH, SINKS, GAUGES, FLUX_LINES, NUMERICS, OUTPUT)
+                                BREACH, SINKS, LEVEL_BOUNDARIES, GAUGES, FLUX_LINES, NUMERICS,
+                                OUTPUT)
 """Every table of the scenario file, in the order the reference lists them."""

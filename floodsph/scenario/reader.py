@@ -25,6 +25,7 @@ from floodsph.scenario.config import (
     Gauges,
     Inflow,
     InitialWater,
+    LevelBoundary,
     OutputConfig,
     OutputFormat,
     Scenario,
@@ -81,6 +82,7 @@ def scenario_from_dict(data: dict, *, source: str, base_dir: Path) -> Scenario:
         sinks=tuple(
             _sink(r, t, join("sinks", i)) for i, t in enumerate(r.table_array(data, "sinks"))
         ),
+        level_boundaries=_level_boundaries(r, data),
         gauges=_gauges(r, data),
         flux_lines=_flux_lines(r, data),
         numerics=_numerics(r, data),
@@ -383,6 +385,66 @@ def _sink(r: Reader, t: dict, p: str) -> Sink:
     if source:
         return Sink(**source)
     return Sink(polygon=r.polygon(t, p, "polygon"))
+
+
+LEVEL_KEYS = ("name", "side", "line", "direction", "level_m", "file")
+"""Keys of a ``[[level_boundaries]]`` entry (``floodsph.scenario.config.LevelBoundary``)."""
+
+
+def _level_boundaries(r: Reader, data: dict) -> tuple[LevelBoundary, ...]:
+    """``[[level_boundaries]]``: each a unique ``name``, a ``side`` (not a closed one, nor one
+    taken by another entry) or a two-point ``line`` (+ ``direction``), and the constant
+    ``level_m`` or a CSV ``file``; the checks that need the DEM are
+    ``floodsph.checks.levels``'."""
+    closed = data.get("terrain", {}).get("closed_sides", [])
+    out: list[LevelBoundary] = []
+    for i, t in enumerate(r.table_array(data, "level_boundaries")):
+        p = join("level_boundaries", i)
+        r.check_keys(t, p, LEVEL_KEYS)
+        name = r.string(t, p, "name")
+        if not name.strip():
+            raise r.fail(join(p, "name"), "must be a non-empty name (it labels the boundary in "
+                                          "run.json)")
+        if name in (b.name for b in out):
+            raise r.fail(join(p, "name"), f"{name!r} names an earlier level boundary too; each "
+                                          "needs its own name")
+        if ("side" in t) == ("line" in t):
+            raise r.fail(p, "expected exactly one of side (a side of the DEM) or line (two "
+                            "points)")
+        side = line = direction = None
+        if "side" in t:
+            side = r.string(t, p, "side")
+            if side not in SIDES:
+                raise r.fail(join(p, "side"), f"unknown side {side!r}; expected one of "
+                                              f"{list(SIDES)}")
+            if isinstance(closed, list) and side in closed:
+                raise r.fail(join(p, "side"), f"{side!r} is listed in terrain.closed_sides too; "
+                                              "a side is either closed or a level boundary")
+            if side in (b.side for b in out):
+                raise r.fail(join(p, "side"), f"{side!r} is the side of an earlier level "
+                                              "boundary too")
+            if "direction" in t:
+                raise r.fail(join(p, "direction"), "only applies with line (a side's water "
+                                                   "lies on the DEM)")
+        else:
+            a, b = r.points(t, p, "line", at_least=2, exactly=2)
+            if a == b:
+                raise r.fail(join(p, "line"), "the two end points are the same")
+            line = (a, b)
+            if "direction" in t:
+                direction = r.point(t["direction"], join(p, "direction"))
+                if direction == (0.0, 0.0):
+                    raise r.fail(join(p, "direction"), "must not be the zero vector")
+        if ("level_m" in t) == ("file" in t):
+            raise r.fail(p, "expected exactly one of level_m (a constant level) or file (a "
+                            "time_s,level_m CSV)")
+        level = r.number(t, p, "level_m", None)
+        if level is not None and abs(level) > ELEVATION_LIMIT_M:
+            raise r.fail(join(p, "level_m"), f"{level:g} m is beyond +-{ELEVATION_LIMIT_M:g} m, "
+                                             "no water surface on Earth")
+        out.append(LevelBoundary(name=name, side=side, line=line, direction=direction,
+                                 level_m=level, file=r.existing_file(t, p, "file", None)))
+    return tuple(out)
 
 
 def _gauges(r: Reader, data: dict) -> Gauges | None:

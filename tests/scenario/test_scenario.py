@@ -120,7 +120,7 @@ POLY = "[[0, 0], [10, 0], [10, 10]]"
          "numerics.cfll: unknown key; allowed keys: cfl, density_tol, "),
         (("[scenario]", "bogus = 1\n[scenario]"),
          "bogus: unknown key; allowed keys: flux_lines, gauges, inflows, initial_water, "
-         "numerics, output, scenario, sinks, terrain, walls"),
+         "level_boundaries, numerics, output, scenario, sinks, terrain, walls"),
         (("level_m = 100.0", "level_m = 100.0\ncolour = 1"),
          "initial_water[0].colour: unknown key; allowed keys: crs, depth, file, layer, level_m, "
          "polygon"),
