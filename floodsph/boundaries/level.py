@@ -62,6 +62,12 @@ class LevelBoundary:
         The boundary's name (run.json) or key path.
     """
 
+    STATE = ("buffer", "reach", "seeded", "d_b", "w_b", "w_i", "level", "volume_in",
+             "volume_out")
+    """What changes during a run (``Boundary.STATE``): the buffer particles, their reach and
+    whether they were seeded, each column's boundary state (depth, invariants), the level
+    imposed last and the volumes in and out."""
+
     def __init__(self, line, normal, series, spacing: float, kappa: float, terrain,
                  name: str = "level_boundaries[0]"):
         a, b = np.asarray(line, dtype=np.float64)
@@ -80,7 +86,7 @@ class LevelBoundary:
         self.bed = bed_at(terrain, x, y)
         self.buffer = {name: np.zeros(0) for name in ("s", "tau", "area", "h", "ratio")}
         self.reach = 0.0
-        self._seeded = False
+        self.seeded = False
         self.d_b = np.zeros(self.count)
         self.w_b = np.zeros(self.count)
         self.w_i = np.zeros(self.count)
@@ -116,9 +122,9 @@ class LevelBoundary:
         (d_B, w_B) to the level at the step's end."""
         t_end = model.t + dt
         self._update_reach(model)
-        if not self._seeded:
+        if not self.seeded:
             self._seed(model)
-            self._seeded = True
+            self.seeded = True
         b = self.buffer
         b["s"] += self.w_b[self._column(b["tau"])] * dt
         self._inject(model)

@@ -348,7 +348,7 @@ FLUX_LINES = TableDoc("flux_lines", True, "Lines through which the discharge is 
     KeyDoc("polyline", POINTS, "The line's vertices (at least two, non-zero length), in the "
            "DEM file's CRS (or scenario.crs). Water crossing from the left of the direction "
            "of travel (first point towards last) to the right counts positive: a line drawn "
-           "from the left bank to the right bank, looking downstream, measures the flow "
+           "from the right bank to the left bank, looking downstream, measures the flow "
            "downstream as positive. Draw it from bank to bank (or beyond the DEM) to catch "
            "all the flow.", "m", required=True),
 ))

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from floodsph.boundaries import Inflow, OpenEdges, Sink, Weir
+from floodsph.boundaries import Inflow, LevelBoundary, OpenEdges, Sink, Weir
 from floodsph.errors import InputError
 from floodsph.simulation.state_arrays import capture, flatten, restore, unflatten
 
@@ -73,7 +73,7 @@ def test_restore_names_the_field_missing_extra_or_of_the_wrong_kind():
                 "ck.npz")
 
 
-@pytest.mark.parametrize("boundary", [Inflow, OpenEdges, Sink, Weir])
+@pytest.mark.parametrize("boundary", [Inflow, OpenEdges, Sink, Weir, LevelBoundary])
 def test_every_boundary_declares_its_state(boundary):
     """A boundary without STATE could not be checkpointed (``Boundary.STATE``)."""
     assert isinstance(boundary.STATE, tuple)

@@ -18,7 +18,7 @@ far end (the mean depth of the water within two spacings of the west wall) and r
 one period of spin-up to the end, the largest |error| against that standing wave and against
 the imposed level, and the volume balance V_0 + V_in - V_out - V [m3] over the run.
 
-Usage: ``python workflows/tide_basin.py [--length 100] [--width 10] [--spacing 2 [1 ...]]
+Usage: ``python benchmarks/tide_basin.py [--length 100] [--width 10] [--spacing 2 [1 ...]]
 [--periods 2] [--out docs/level-boundary-benchmark.md]``
 """
 
@@ -165,7 +165,7 @@ def main(argv=None) -> list[dict]:
         rows.append(row)
     if args.out is not None:
         spacings = " ".join(f"{s:g}" for s in args.spacing)
-        command = (f"python workflows/tide_basin.py --spacing {spacings} --out "
+        command = (f"python benchmarks/tide_basin.py --spacing {spacings} --out "
                    f"{args.out.as_posix()}")
         args.out.write_text(table(rows, command), encoding="utf-8")
         print(f"wrote {args.out}")

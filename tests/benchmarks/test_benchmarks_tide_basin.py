@@ -1,14 +1,17 @@
-"""``workflows/tide_basin.py``: a tide in a basin open at one end, the far-end level against
+"""``benchmarks/tide_basin.py``: a tide in a basin open at one end, the far-end level against
 the forced standing wave (a short run of a small basin)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from conftest import load_workflow
+import pytest
+from conftest import load_script
 
-WORKFLOWS = Path(__file__).resolve().parents[2] / "workflows"
-tide_basin = load_workflow("tide_basin_benchmark", WORKFLOWS / "tide_basin.py")
+pytestmark = pytest.mark.benchmark
+
+BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+tide_basin = load_script("tide_basin_benchmark", BENCHMARKS / "tide_basin.py")
 
 
 def test_a_small_basin_follows_the_tide_and_keeps_its_volume_balance():
@@ -29,6 +32,6 @@ def test_the_table_reports_the_errors_and_the_balance():
            "volume_initial": 1500.0, "volume_in": 2100.0, "volume_out": 2099.0,
            "volume_final": 1501.0, "imbalance": 2e-12, "particles": 380, "steps": 9000,
            "wall_s": 30.0}
-    text = tide_basin.table([row], "python workflows/tide_basin.py")
+    text = tide_basin.table([row], "python benchmarks/tide_basin.py")
     assert "| 2 | 1.67 cm | 2.01 cm | 1500.000 | 2100.000 | 2099.000 |" in text
     assert "| 2.00e-12 | 380 |" in text
