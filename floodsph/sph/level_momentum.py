@@ -100,7 +100,7 @@ from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.bed import BED, elevation_at
-from floodsph.sph.kernels import dwdr_over_r_cubic, w_cubic
+from floodsph.sph.kernels import beyond_support, dwdr_over_r_cubic, w_cubic
 from floodsph.sph.level_offsets import FREE
 from floodsph.walls.geometry import mirror
 from floodsph.walls.images import moving_image
@@ -165,7 +165,9 @@ def _add_pair(acc, rx, ry, vx, vy, deta, i, j, m, rho, h):
 def _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, eta, seg, s, s2, ds):
     """Add the images of i and of its unblocked neighbours about segment s (s2 < 0) or
     through the corner of s and s2 to i's sums (:func:`_add_pair`); ``ds`` is i's distance
-    to s [m] (0 for a corner): images beyond the pair's support are skipped."""
+    to s [m] (0 for a corner): images beyond the pair's support are skipped, by that bound
+    and then by their own distance (``floodsph.sph.kernels.beyond_support``: their terms are
+    exactly zero)."""
     hi = h[i]
     for q in range(nstart[i] - 1, nstart[i + 1]):
         if q < nstart[i]:
@@ -177,7 +179,7 @@ def _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, eta, seg, s
             if blocked[q] or ds >= 2.0 * max(hi, h[j]) + SIGHT_SLACK:
                 continue
         ok, xm, ym, um, vm = moving_image(x[i], y[i], x[j], y[j], u[j], v[j], seg, s, s2)
-        if ok:
+        if ok and not beyond_support(x[i] - xm, y[i] - ym, max(hi, h[j])):
             acc = _add_pair(acc, x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, eta[j] - eta[i], i,
                             j, m, rho, h)
     return acc
