@@ -10,6 +10,9 @@ stage timer (``floodsph.model.stage_timer``) adding up the wall time of each sta
 size: particle-steps/s, ms per step and the stages' share in us per step, medians over
 ``--repeats``; and a least-squares fit of the time per step, t = fixed + per_particle n, over
 the sizes: ``fixed`` is the cost of a step that does not grow with the particles.
+``--momentum balanced`` measures the balanced momentum (``numerics.momentum``) instead of the
+variational one. Each row also gives the neighbour-list builds per step (the model's
+``neighbour_builds`` counter, where the checkout has it).
 
 ``--compare REF`` runs the same measurements on a second checkout in the same invocation,
 each checkout in its own worker process, alternating one measurement of each (so that both
@@ -19,7 +22,7 @@ once with ``git archive`` into ``--ref-dir`` (so its compiled kernels are cached
 A checkout without the stage timer reports its totals only.
 
     python benchmarks/step_cost.py [--steps 200] [--repeats 3] [--threads 1]
-        [--compare REF] [--out docs/step-cost.md] [--quick]
+        [--momentum variational|balanced] [--compare REF] [--out docs/step-cost.md] [--quick]
 """
 
 from __future__ import annotations
@@ -52,6 +55,7 @@ LOCATIONS = {
     "Numerics": (("floodsph.scenario.numerics", "Numerics"), ("floodsph.numerics", "Numerics")),
     "TimeStepping": (("floodsph.scenario.numerics", "TimeStepping"),
                      ("floodsph.numerics", "TimeStepping")),
+    "Momentum": (("floodsph.scenario.numerics", "Momentum"), ("floodsph.numerics", "Momentum")),
     "set_threads": (("floodsph.run.pipeline", "set_threads"), ("floodsph.run", "set_threads")),
     "StageTimer": (("floodsph.model.stage_timer", "StageTimer"),
                    ("floodsph.stage_timer", "StageTimer")),
@@ -72,10 +76,11 @@ def piece(name: str):
     raise ImportError(f"step_cost: this floodsph has no {name}")
 
 
-def dam_break(spacing: float):
-    """The FloodModel of the dam break at ``spacing`` [m] (module docstring), built from the
-    public pieces only (``Terrain``, ``ParticleSet``, ``Numerics``, the model's set-up), so
-    that any checkout builds the same case."""
+def dam_break(spacing: float, momentum: str = "variational"):
+    """The FloodModel of the dam break at ``spacing`` [m] (module docstring) under the
+    ``momentum`` named (``numerics.momentum``), built from the public pieces only
+    (``Terrain``, ``ParticleSet``, ``Numerics``, the model's set-up), so that any checkout
+    builds the same case."""
     from floodsph.constants import RHO_WATER
 
     set_up_model, ParticleSet, Terrain, Numerics = (
@@ -87,25 +92,28 @@ def dam_break(spacing: float):
     x, y = (a.ravel() for a in np.meshgrid(x1, y1))
     p = ParticleSet(x.size)
     # one global step, so that a step is one update of every particle in every checkout
+    chosen = {} if momentum == "variational" else {"momentum": piece("Momentum")(momentum)}
     numerics = Numerics(particle_spacing_m=spacing,
-                        time_stepping=piece("TimeStepping").GLOBAL)
+                        time_stepping=piece("TimeStepping").GLOBAL, **chosen)
     p.append(x=x, y=y, m=np.full(x.size, RHO_WATER * DEPTH_M * spacing * spacing),
              rho=np.full(x.size, RHO_WATER * DEPTH_M),
              h=np.full(x.size, numerics.kappa * spacing))
     return set_up_model(terrain, p, numerics)
 
 
-def measure(spacing: float, steps: int, warmup: int) -> dict:
-    """One measurement of the dam break at ``spacing``: ``particles``, ``steps``,
-    ``particle_steps_per_s`` and ``ms_per_step`` of the timed steps, and each stage's
-    ``us_<stage>`` per step when the checkout has the stage timer."""
-    model = dam_break(spacing)
+def measure(spacing: float, steps: int, warmup: int, momentum: str = "variational") -> dict:
+    """One measurement of the dam break at ``spacing`` under ``momentum``: ``particles``,
+    ``steps``, ``particle_steps_per_s`` and ``ms_per_step`` of the timed steps,
+    ``list_builds_per_step`` and each stage's ``us_<stage>`` per step when the checkout has
+    the counter and the stage timer."""
+    model = dam_break(spacing, momentum)
     for _ in range(warmup):
         model.step()
     timer = None
     if hasattr(model, "stage_timer"):  # else a checkout from before the stage timer
         timer = model.stage_timer = piece("StageTimer")()
     updates = model.counters["particle_updates"]
+    builds = model.counters.get("neighbour_builds")
     t0 = time.perf_counter()
     for _ in range(steps):
         model.step()
@@ -113,6 +121,8 @@ def measure(spacing: float, steps: int, warmup: int) -> dict:
     row = {"particles": model.particles.n, "steps": steps,
            "particle_steps_per_s": (model.counters["particle_updates"] - updates) / wall,
            "ms_per_step": 1e3 * wall / steps}
+    if builds is not None:
+        row["list_builds_per_step"] = (model.counters["neighbour_builds"] - builds) / steps
     if timer is not None:
         row |= {f"us_{stage}": 1e6 * s / steps for stage, s in timer.seconds.items()}
     return row
@@ -206,7 +216,8 @@ def fixed_cost(rows: list[dict]) -> tuple[float, float]:
     return float(fixed), 1e3 * float(k)
 
 
-def run(checkouts, sizes, steps: int, warmup: int, repeats: int) -> list[dict]:
+def run(checkouts, sizes, steps: int, warmup: int, repeats: int,
+        momentum: str = "variational") -> list[dict]:
     """Median measurement per checkout and size, the checkouts alternating (in turned order
     from one repeat to the next)."""
     samples = {(c.name, size): [] for c in checkouts for size in sizes}
@@ -215,7 +226,8 @@ def run(checkouts, sizes, steps: int, warmup: int, repeats: int) -> list[dict]:
             order = checkouts if rep % 2 == 0 else checkouts[::-1]
             for c in order:
                 samples[c.name, size].append(
-                    c.measure(spacing=SIZES[size], steps=steps, warmup=warmup))
+                    c.measure(spacing=SIZES[size], steps=steps, warmup=warmup,
+                              momentum=momentum))
     rows = []
     for (name, size), got in samples.items():
         row = {"checkout": name, "size": size}
@@ -231,8 +243,9 @@ def report(rows: list[dict], names: list[str], command: str) -> str:
     from floodsph.output.tables import markdown
 
     stages = [k for k in rows[0] if k.startswith("us_")]
+    builds = ["list_builds_per_step"] if "list_builds_per_step" in rows[0] else []
     columns = ["checkout", "particles", "steps", "particle_steps_per_s", "ms_per_step",
-               *stages]
+               *builds, *stages]
     table = [{c: r.get(c, float("nan")) for c in columns} for r in rows]
     fits = []
     for name in names:
@@ -269,6 +282,8 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=1, help="numba threads (0 = all cores)")
     ap.add_argument("--sizes", type=int, nargs="+", default=sorted(SIZES),
                     choices=sorted(SIZES), help="nominal particle counts")
+    ap.add_argument("--momentum", choices=("variational", "balanced"), default="variational",
+                    help="numerics.momentum of the dam break")
     ap.add_argument("--compare", metavar="REF", help="a second checkout: path or commit")
     ap.add_argument("--ref-dir", type=Path,
                     default=Path(tempfile.gettempdir()) / "floodsph-step-cost",
@@ -291,7 +306,8 @@ def main(argv=None) -> int:
         set_threads(args.threads)
         checkouts = [InProcess()]
     try:
-        rows = run(checkouts, args.sizes, args.steps, args.warmup, args.repeats)
+        rows = run(checkouts, args.sizes, args.steps, args.warmup, args.repeats,
+                   args.momentum)
     finally:
         for c in checkouts:
             c.close()

@@ -525,7 +525,7 @@ class FloodModel:
             shore.balance_shores(rows, p.x, p.y, p.u, p.v, p.rho, p.h, self.bed, t.dx, t.dy,
                                  t.elevation, self.pair_sums, self.walled, p.ax, p.ay)
         forces.add_bed_acceleration(rows, p.u, p.v, self.bed, self.numerics.max_slope, p.ax,
-                                    p.ay)
+                                    p.ay, GRAVITY, 0.0)
 
     def _balanced_forces(self, rows: np.ndarray) -> None:
         """The balanced momentum's accelerations of the particles ``rows``

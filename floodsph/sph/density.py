@@ -36,10 +36,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from floodsph.sph.kernels import w_cubic, w_dwdr_cubic
+from floodsph.sph.kernels import beyond_support, w_cubic, w_dwdr_cubic
 from floodsph.sph.shadow import shadow
-from floodsph.walls.images import corner_image, wall_image
-from floodsph.walls.sight import SIGHT_SLACK
+from floodsph.walls.geometry import mirror
+from floodsph.walls.images import corner_image
+from floodsph.walls.sight import SIGHT_SLACK, hides
 
 H_SHRINK_MIN = 0.8
 """In a time step, h_i >= H_SHRINK_MIN h_i(guess), i.e. rho_i at most 1.56 times its continuity
@@ -58,12 +59,17 @@ def _pair(rx, ry, mj, hi):
 @njit(inline="always", cache=True)
 def _image(i, j, x, y, m, hi, seg, s):
     """m_j W(r, h_i) [kg m-2] and m_j r dW/dr [kg m-2] of j's mirror image across segment s
-    (x_j' = 2 f_j - x_j, ``floodsph.walls.images.wall_image``) seen from i; (0, 0) when the wall
-    does not hide that image's point from i (MVBP mirror particles, ``docs/method.md`` §7)."""
-    xm, ym, ok = wall_image(x[i], y[i], x[j], y[j], seg, s)
-    if not ok:
+    (x_j' = 2 f_j - x_j, as ``floodsph.walls.images.wall_image`` places it) seen from i;
+    (0, 0) when the wall does not hide that image's point from i (MVBP mirror particles,
+    ``docs/method.md`` §7), or when the image is beyond i's support, where both terms are
+    exactly zero (``floodsph.sph.kernels.beyond_support``; tested first, it spares most
+    images their sight test)."""
+    xm, ym, _, _, _ = mirror(x[j], y[j], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+    rx = x[i] - xm
+    ry = y[i] - ym
+    if beyond_support(rx, ry, hi) or not hides(x[i], y[i], xm, ym, seg, s):
         return 0.0, 0.0
-    return _pair(x[i] - xm, y[i] - ym, m[j], hi)
+    return _pair(rx, ry, m[j], hi)
 
 
 @njit(inline="always", cache=True)

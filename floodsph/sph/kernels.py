@@ -30,6 +30,22 @@ SIGMA_2D = 10.0 / (7.0 * math.pi)
 """Normalisation constant of the 2-D cubic spline, W(0, h) = SIGMA_2D / h^2."""
 
 
+BEYOND_SUPPORT = 1.0 + 1e-9
+"""A pair at r^2 >= BEYOND_SUPPORT (2 h)^2 is beyond the support of every kernel here, in
+floating point too: r = sqrt(r^2) then exceeds 2 h by 5e-10 relative, far above the rounding
+of q = r / h or r (1 / h) (1e-16), so q >= 2 and W, dW/dr and their quotients by r evaluate
+to exactly zero (:func:`beyond_support`)."""
+
+
+@njit(inline="always", cache=True)
+def beyond_support(rx, ry, h):
+    """True when the separation (rx, ry) [m] is beyond the support 2h [m] by the margin
+    ``BEYOND_SUPPORT``: every kernel term of the pair is exactly zero, and a sum may skip it
+    bit for bit (a sum that starts at +0 is never -0, so adding a zero of either sign leaves
+    it unchanged). Used to skip mirror images before their sight test and pair terms."""
+    return rx * rx + ry * ry >= BEYOND_SUPPORT * 4.0 * h * h
+
+
 def seeded_smoothing_length(kappa, spacing):
     """h0 = kappa dx [m]: the smoothing length of particles seeded at ``spacing`` dx [m]
     (``numerics.kappa``, ``docs/method.md`` §2). The one place it is computed: the seeding,

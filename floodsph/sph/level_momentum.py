@@ -100,7 +100,7 @@ from numba import njit, prange
 
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.bed import BED, elevation_at
-from floodsph.sph.kernels import dwdr_over_r_cubic, w_cubic
+from floodsph.sph.kernels import beyond_support, dwdr_over_r_cubic, w_cubic
 from floodsph.sph.level_offsets import FREE
 from floodsph.walls.geometry import mirror
 from floodsph.walls.images import moving_image
@@ -135,25 +135,26 @@ test (test 2): moving water's rows behind a front need the push."""
 
 
 @njit(inline="always", cache=True)
-def _add_pair(acc, rx, ry, vx, vy, deta, i, j, m, rho, h):
+def _add_pair(acc, rx, ry, vx, vy, deta, i, j, m, rho, h, inv_h, wave):
     """Add the pair of i and j (or j's image) at r = x_i - x_j, v = v_i - v_j, with the level
     difference deta = eta_j - eta_i [m], to i's sums ``acc``:
     0-1 shock-capturing acceleration [m s-2], 2-3 S [-], 4-6 -N (xx, xy, yy) [-],
-    7-8 -e (x, y) [m-1], 9 the divergence sum, sum m_j F(r, h_i) (v . r) [kg m-2 s-1]."""
+    7-8 -e (x, y) [m-1], 9 the divergence sum, sum m_j F(r, h_i) (v . r) [kg m-2 s-1].
+    ``inv_h`` and ``wave`` are every particle's 1 / h [m-1] and c = sqrt(g rho / rho_w)
+    [m s-1] (:func:`_particle_factors`)."""
     r2 = rx * rx + ry * ry
     if r2 <= 0.0:
         return acc
     r = math.sqrt(r2)
     inv_r = 1.0 / r
-    fi = dwdr_over_r_cubic(r, inv_r, 1.0 / h[i])
-    fj = dwdr_over_r_cubic(r, inv_r, 1.0 / h[j])
+    fi = dwdr_over_r_cubic(r, inv_r, inv_h[i])
+    fj = dwdr_over_r_cubic(r, inv_r, inv_h[j])
     w = 0.5 * m[j] / rho[j] * (fi + fj)
     vr = vx * rx + vy * ry
     fv = 0.0
     if vr < 0.0:
         hbar = 0.5 * (h[i] + h[j])
-        cbar = 0.5 * (math.sqrt(GRAVITY * rho[i] / RHO_WATER)
-                      + math.sqrt(GRAVITY * rho[j] / RHO_WATER))
+        cbar = 0.5 * (wave[i] + wave[j])
         pi_ij = -cbar * vr / (0.5 * (rho[i] + rho[j]) * math.sqrt(r2 + 0.01 * hbar * hbar))
         fv = m[j] * 0.5 * pi_ij * (fi + fj)
     return (acc[0] - fv * rx, acc[1] - fv * ry, acc[2] + w * deta * rx, acc[3] + w * deta * ry,
@@ -161,11 +162,24 @@ def _add_pair(acc, rx, ry, vx, vy, deta, i, j, m, rho, h):
             acc[7] + w * rx, acc[8] + w * ry, acc[9] + m[j] * fi * vr)
 
 
+@njit(parallel=True, cache=True)
+def _particle_factors(rho, h, inv_h, wave):
+    """Each particle's 1 / h [m-1] into ``inv_h`` and wave speed c = sqrt(g rho / rho_w)
+    [m s-1] into ``wave``: computed once per evaluation, not once per pair (the same
+    numbers)."""
+    for i in prange(h.shape[0]):
+        inv_h[i] = 1.0 / h[i]
+        wave[i] = math.sqrt(GRAVITY * rho[i] / RHO_WATER)
+
+
 @njit(inline="always", cache=True)
-def _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, eta, seg, s, s2, ds):
+def _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, inv_h, wave, eta, seg, s,
+                s2, ds):
     """Add the images of i and of its unblocked neighbours about segment s (s2 < 0) or
     through the corner of s and s2 to i's sums (:func:`_add_pair`); ``ds`` is i's distance
-    to s [m] (0 for a corner): images beyond the pair's support are skipped."""
+    to s [m] (0 for a corner): images beyond the pair's support are skipped, by that bound
+    and then by their own distance (``floodsph.sph.kernels.beyond_support``: their terms are
+    exactly zero)."""
     hi = h[i]
     for q in range(nstart[i] - 1, nstart[i + 1]):
         if q < nstart[i]:
@@ -177,9 +191,9 @@ def _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, eta, seg, s
             if blocked[q] or ds >= 2.0 * max(hi, h[j]) + SIGHT_SLACK:
                 continue
         ok, xm, ym, um, vm = moving_image(x[i], y[i], x[j], y[j], u[j], v[j], seg, s, s2)
-        if ok:
+        if ok and not beyond_support(x[i] - xm, y[i] - ym, max(hi, h[j])):
             acc = _add_pair(acc, x[i] - xm, y[i] - ym, u[i] - um, v[i] - vm, eta[j] - eta[i], i,
-                            j, m, rho, h)
+                            j, m, rho, h, inv_h, wave)
     return acc
 
 
@@ -291,6 +305,9 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
     still water held by its banks (module docstring); ``ghost`` receives each
     particle's ghost depth d* [m] (0: no free edge)."""
     seg, wdist, wstart, wseg, cstart, cpair = walls
+    inv_h = np.empty(h.shape[0])
+    wave = np.empty(h.shape[0])
+    _particle_factors(rho, h, inv_h, wave)
     for k in prange(rows.shape[0]):
         i = rows[k]
         xi = x[i]
@@ -307,7 +324,7 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
             if rx * rx + ry * ry >= hm * hm or blocked[q]:
                 continue
             acc = _add_pair(acc, rx, ry, u[i] - u[j], v[i] - v[j], eta[j] - eta[i], i, j, m,
-                            rho, h)
+                            rho, h, inv_h, wave)
         w = wstart[i]
         cc = cstart[i]
         single = True
@@ -327,8 +344,8 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
                 w += 1
                 single = True
                 continue
-            acc = _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, eta, seg, s,
-                              s2, ds)
+            acc = _add_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, inv_h, wave,
+                              eta, seg, s, s2, ds)
         nxx = -acc[4]
         nxy = -acc[5]
         nyy = -acc[6]

@@ -64,3 +64,18 @@ def test_the_stage_timer_counts_only_the_steps_taken_while_it_is_set():
 def test_a_compare_reference_that_is_neither_a_checkout_nor_a_commit_is_named(tmp_path):
     with pytest.raises(SystemExit, match="no-such-ref"):
         step_cost.reference_root("no-such-ref", tmp_path)
+
+
+def test_the_balanced_form_measures_the_balanced_momentum_and_counts_the_list_builds(tmp_path):
+    """``--momentum balanced`` builds the dam break under the balanced momentum (its lake
+    at rest has levels to balance), and every row says how often the lists were built: at
+    least once in the run's steps and at most twice a step (the build at the step and the
+    one repeat of a capped density solve)."""
+    assert step_cost.dam_break(10.0, "balanced").balanced
+    assert not step_cost.dam_break(10.0).balanced
+    out = tmp_path / "step-cost.md"
+    assert step_cost.main(["--quick", "--momentum", "balanced", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert "--momentum balanced" in text
+    for r in table_rows(text, "checkout"):
+        assert 0.0 < float(r["list_builds_per_step"]) <= 2.0

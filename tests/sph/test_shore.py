@@ -3,6 +3,7 @@
 import numpy as np
 from sph_cases import model_on, run_until
 
+from floodsph.constants import GRAVITY
 from floodsph.sph import forces
 from floodsph.sph.sums import SUMS
 
@@ -19,7 +20,7 @@ def variational_acceleration(model):
                                  model.wall_lists(), model.scheme, np.empty((p.n, SUMS)), ax,
                                  ay, divv)
     forces.add_bed_acceleration(model.nl.rows, p.u, p.v, model.bed, model.numerics.max_slope,
-                                ax, ay)
+                                ax, ay, GRAVITY, 0.0)
     return ax, ay
 
 

@@ -6,7 +6,14 @@ from scipy.integrate import quad
 from scipy.spatial import cKDTree
 from sph_cases import model_on
 
-from floodsph.sph.kernels import SIGMA_2D, dwdr_over_r_cubic, w_cubic, w_dwdr_cubic
+from floodsph.sph.kernels import (
+    SIGMA_2D,
+    beyond_support,
+    dwdr_over_r_cubic,
+    dwdr_over_r_floored,
+    w_cubic,
+    w_dwdr_cubic,
+)
 from floodsph.sph.neighbours import NeighbourList
 
 
@@ -16,6 +23,29 @@ def test_kernel_is_normalised_and_compact(h):
     assert area == pytest.approx(1.0, abs=1e-10)
     assert w_cubic(2.0 * h, h) == 0.0 and w_cubic(2.0001 * h, h) == 0.0
     assert w_cubic(0.0, h) == pytest.approx(SIGMA_2D / h**2)
+
+
+
+def test_every_kernel_term_is_exactly_zero_where_beyond_support_skips_the_pair():
+    """Images that ``beyond_support`` skips must contribute exactly nothing: at the first
+    separations it accepts, every kernel form evaluates to zero, with r and 1 / h rounded as
+    the pair loops round them."""
+    rng = np.random.default_rng(5)
+    skipped = 0
+    for h in np.exp(rng.uniform(np.log(0.01), np.log(500.0), 2000)):
+        angle = rng.uniform(0.0, 2.0 * np.pi)
+        for r in np.nextafter(2.0 * h * np.sqrt(1.0 + 1e-9), 0.0) * np.array([1.0, 1.0 + 1e-15]):
+            rx, ry = r * np.cos(angle), r * np.sin(angle)
+            if not beyond_support(rx, ry, h):
+                continue
+            skipped += 1
+            rr = np.sqrt(rx * rx + ry * ry)
+            w, dwdr = w_dwdr_cubic(rr, h)
+            assert w == 0.0 and dwdr == 0.0 and w_cubic(rr, h) == 0.0
+            assert dwdr_over_r_cubic(rr, 1.0 / rr, 1.0 / h) == 0.0
+            assert dwdr_over_r_floored(rr, 1.0 / rr, 1.0 / h) == 0.0
+    assert skipped > 1000
+    assert not beyond_support(2.0 * 0.999999 * 3.0, 0.0, 3.0)
 
 
 def test_kernel_derivative_matches_finite_difference():
