@@ -101,9 +101,9 @@ def scenario_file(write_scenario) -> Path:
     return write_scenario()
 
 
-def load_workflow(name: str, path: Path):
-    """Import a workflow script (``workflows/...``) as module ``name``; its folder goes on
-    ``sys.path`` so that it finds the modules beside it."""
+def load_script(name: str, path: Path):
+    """Import a script (``workflows/...`` or ``benchmarks/...``) as module ``name``; its folder
+    goes on ``sys.path`` so that it finds the modules beside it."""
     if str(path.parent) not in sys.path:
         sys.path.insert(0, str(path.parent))
     spec = importlib.util.spec_from_file_location(name, path)

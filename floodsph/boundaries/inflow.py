@@ -80,6 +80,10 @@ class Inflow:
         Key path for error messages, e.g. ``"scenario.toml: inflows[0]"``.
     """
 
+    STATE = ("phase", "d_b", "w_b", "regime", "volume_in", "t")
+    """What changes during a run (``Boundary.STATE``): the buffer's offset, the boundary
+    state and regime, the volume injected and the time of the last call."""
+
     def __init__(self, line, hydrograph, spacing: float, kappa: float, terrain,
                  direction=None, name: str = "inflows[0]"):
         a, b = np.asarray(line, dtype=np.float64)

@@ -96,6 +96,10 @@ class OpenEdges:
         Open sides among ``"west", "east", "south", "north"``.
     """
 
+    STATE = ("buffer", "reach", "volume_out", "volume_out_sides", "seeded")
+    """What changes during a run (``Boundary.STATE``): the buffer particles, their reach,
+    the volumes out (in all and by side) and whether the buffer was seeded."""
+
     def __init__(self, width: float, height: float, sides):
         self.width = float(width)
         self.height = float(height)
@@ -104,7 +108,7 @@ class OpenEdges:
         self.reach = 0.0
         self.volume_out = 0.0
         self.volume_out_sides = dict.fromkeys(self.sides, 0.0)
-        self._seeded = False
+        self.seeded = False
         self._ghosts = slice(0, 0)
 
     def _beyond(self, x, y) -> np.ndarray:
@@ -126,9 +130,9 @@ class OpenEdges:
         """Move the buffer, take in the water that crossed an open side, drop what left reach."""
         p = model.particles
         self._update_reach(model)
-        if not self._seeded:
+        if not self.seeded:
             self._seed(p)
-            self._seeded = True
+            self.seeded = True
         b = self.buffer
         b["x"] += b["u"] * dt
         b["y"] += b["v"] * dt

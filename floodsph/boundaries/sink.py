@@ -30,6 +30,9 @@ class Sink:
         Width [m] of the protected band around the sink (no coalescing there).
     """
 
+    STATE = ("volume_out",)
+    """What changes during a run (``Boundary.STATE``): the volume absorbed [m3]."""
+
     def __init__(self, polygon, terrain, reach: float):
         from scipy.ndimage import binary_dilation
 

@@ -115,6 +115,10 @@ class Weir:
 
     opening = None
     """No section: the wall stays a wall to the particles (``Boundary.opening``)."""
+    STATE = ("owed", "emitted", "volume_to_right", "volume_to_left", "discharge", "head",
+             "levels")
+    """What changes during a run (``Boundary.STATE``): each piece's volume owed, particles
+    emitted, last discharge, head and levels, and the volumes passed each way."""
 
     def __init__(self, crest: Crest, spacing: float, kappa: float,
                  coefficient: float = IDEAL_COEFFICIENT, name: str = "walls[0]"):

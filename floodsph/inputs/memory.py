@@ -37,7 +37,7 @@ Bytes, at the larger of the two peaks (seeding, then the run)::
   ``ru_maxrss``) of a whole run of a 200-particle valley, where the base is all there is:
   399-418 MiB with the kernels cached, 649 MiB when they compile. On the sample
   (``data_samples/valley``, 9,300 particles at peak, cached kernels) the peak is 454 MiB; on
-  Malpasset (``workflows/malpasset``, the sea as particles, 17,900 at peak, one thread)
+  Malpasset (``benchmarks/malpasset``, the sea as particles, 17,900 at peak, one thread)
   612 MiB.
 
 Every count comes from shapes and areas known before the arrays exist (``floodsph.inputs.prepare``

@@ -12,6 +12,11 @@ GAUGES_NAME = "gauges.csv"
 FLUX_NAME = "flux.csv"
 SNAPSHOTS_NAME = "snapshots.nc"
 CHECKPOINT_DIR = "checkpoint"
+CHECKPOINT_NAME = "state.npz"
+"""The checkpoint in ``CHECKPOINT_DIR``: named arrays (``floodsph.simulation.checkpoint``)."""
+PICKLED_CHECKPOINT_NAME = "state.pkl"
+"""The checkpoint of floodsph before format 5 (a Python pickle): recognised, never read."""
+CHECKPOINT_NAMES = (CHECKPOINT_NAME, PICKLED_CHECKPOINT_NAME)
 STAGING_DIR = ".floodsph-new"
 LOCK_NAME = ".floodsph.lock"
 MAP_NAMES = (

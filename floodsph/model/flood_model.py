@@ -51,6 +51,7 @@ from floodsph.walls.index import MapWalls, WallIndex, WallLists
 from floodsph.walls.sight import SIGHT_SLACK
 
 if TYPE_CHECKING:
+    from floodsph.model.stage_timer import StageTimer
     from floodsph.simulation.flux import FluxLines
 
 MAX_SEARCH_GROWTH = 2.0
@@ -98,15 +99,23 @@ class FloodModel:
     stage_timer : StageTimer or None
         Set it to a ``floodsph.model.stage_timer.StageTimer`` to have every step add the wall time
         of each of its stages there (None, the default: no timing).
+    flux_lines : FluxLines or None
+        ``floodsph.simulation.flux.FluxLines`` counting the water that crosses the scenario's
+        flux lines (every move of a particle: :meth:`count_moves`), or None (the default).
+    volume_out_other : float
+        Outflow [m3] off the grid or into nodata cells that no open side or sink took
+        (:meth:`remove_outside`).
     """
 
-    stage_timer = None  # a class default, so that models pickled before it existed load
-    flux_lines: FluxLines | None = None
-    """``floodsph.simulation.flux.FluxLines`` counting the water that crosses the scenario's
-    flux lines (every move of a particle: :meth:`count_moves`), or None."""
-    volume_out_other = 0.0
-    """Outflow [m3] off the grid or into nodata cells that no open side or sink took
-    (:meth:`remove_outside`)."""
+    STATE = ("t", "steps", "dt", "volume_in", "volume_out", "volume_out_other",
+             "volume_seed_adjustment", "counters", "bed", "pair_sums", "blocked", "wdist",
+             "eta", "ghost", "walled")
+    """What a checkpoint holds of the model itself (``floodsph.simulation.state_arrays``): the
+    clock, the volumes, the counters and the per-particle arrays the last step left (the
+    sampled bed, the pair sums, the blocked pairs and wall distances, the levels and ghost
+    depths, the walled flags), which the next step may read before it writes them. Its
+    particles, lists, boundaries, refiner and flux lines declare their own
+    (``floodsph.simulation.model_state``); the rest is made again from the scenario."""
 
     def __init__(self, terrain: Terrain, particles: ParticleSet, numerics: Numerics,
                  seg: np.ndarray, closed_sides: frozenset[str], boundaries,
@@ -129,6 +138,9 @@ class FloodModel:
         self.volume_in = 0.0
         self.volume_out = 0.0
         self.volume_seed_adjustment = 0.0
+        self.volume_out_other = 0.0
+        self.stage_timer: StageTimer | None = None
+        self.flux_lines: FluxLines | None = None
         self.counters = {"splits": 0, "merges": 0, "particles_max": particles.n,
                          "wall_reflections": 0, "density_unconverged": 0,
                          "density_capped": 0, "density_held": 0, "particle_updates": 0,
@@ -206,7 +218,7 @@ class FloodModel:
             timer.begin()
         self.lists_fresh = False
         self._nl_here = False
-        if getattr(self, "nl", None) is None:  # particles were added or removed between steps
+        if self.nl is None:  # particles were added or removed between steps
             self.update_lists()
         if self.numerics.time_stepping is TimeStepping.LOCAL:
             dt = big_step(self, dt_max)
@@ -369,7 +381,7 @@ class FloodModel:
         near-wall lists still cover every particle, for the drift).
         """
         p = self.particles
-        nl = getattr(self, "nl", None)
+        nl = self.nl
         if not force and nl is not None and nl.still_valid(p.x, p.y, p.h):
             self._lap("neighbours")
             return

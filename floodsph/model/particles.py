@@ -67,6 +67,10 @@ class ParticleSet:
         Number of particles the arrays can hold before they are reallocated (doubled).
     """
 
+    STATE = ("capacity", "n", "next_pid", *FIELDS)
+    """What a checkpoint holds (``floodsph.simulation.state_arrays``): the room, the count and
+    the next id, then every field of the active particles; restored in this order."""
+
     def __init__(self, capacity: int = 1024):
         capacity = max(int(capacity), 1)
         self._data: dict[str, np.ndarray] = {
@@ -77,6 +81,17 @@ class ParticleSet:
     @property
     def capacity(self) -> int:
         return self._data["x"].shape[0]
+
+    @capacity.setter
+    def capacity(self, capacity: int) -> None:
+        """Reallocate every field to exactly ``capacity`` particles, keeping the first ones
+        (as many as fit)."""
+        capacity = max(int(capacity), 1)
+        self.n = min(self.n, capacity)
+        for name, arr in self._data.items():
+            room = np.zeros(capacity, dtype=arr.dtype)
+            room[: self.n] = arr[: self.n]
+            self._data[name] = room
 
     def __getattr__(self, name: str) -> np.ndarray:
         data = self.__dict__.get("_data")

@@ -43,7 +43,7 @@ which (no_merge_steps later, away from walls, fronts and bores) merge pairwise b
 0.55 - 0.7 A0 and then 1.1 - 1.4 A0, so that the seven daughters of a thinning sheet become
 two or three particles, not seven; a merged pair stays below 2 area_min < area_max, so it
 does not split again at once (the hysteresis). With these defaults
-``workflows/refinement_benchmark.py`` measured (README, one thread, kappa 1.3) 4.2 times the
+``benchmarks/refinement_benchmark.py`` measured (README, one thread, kappa 1.3) 4.2 times the
 speed of splitting alone on the sample valley and 8.6-9.0 times on Malpasset at 20 m (4.6
 times before small particles were absorbed), with max-depth maps that agree to CSI 0.993 and
 0.954;
@@ -95,6 +95,10 @@ class Refiner:
         ``particle_spacing_m`` [m]: the area thresholds are multiples of spacing^2.
     """
 
+    STATE = ("last_call",)
+    """What changes during a run (``floodsph.simulation.state_arrays``): the step of the last
+    call, which the merge interval and the relaxation rate count from."""
+
     def __init__(self, numerics: Numerics):
         spacing = numerics.particle_spacing_m
         if spacing is None:
@@ -103,7 +107,7 @@ class Refiner:
         self.spacing = float(spacing)
         self.area_max = numerics.refine_area_max * self.spacing**2
         self.area_min = numerics.refine_area_min * self.spacing**2
-        self._last_call = -1  # model.steps at the last apply: merges are due every
+        self.last_call = -1  # model.steps at the last apply: merges are due every
         # refine_merge_interval steps, also when a call ends several (local time stepping)
 
     @classmethod
@@ -123,10 +127,10 @@ class Refiner:
         compounded rate of the steps since the last call (several with local time stepping).
         """
         s = self.numerics
-        steps = model.steps - self._last_call
+        steps = model.steps - self.last_call
         every = s.refine_merge_interval
-        merge_due = model.steps // every != self._last_call // every
-        self._last_call = model.steps
+        merge_due = model.steps // every != self.last_call // every
+        self.last_call = model.steps
         if not s.refinement.splits or model.particles.n == 0:
             return 0, 0
         rate = RELAX_RATE if steps == 1 else 1.0 - (1.0 - RELAX_RATE) ** steps

@@ -1,7 +1,7 @@
 """Say on screen when numba compiles floodsph's kernels, and how long it took.
 
 The kernels are compiled on their first use and cached on disk (``@njit(cache=True)``), so a
-first run spends most of a minute compiling before its first step (``workflows/compile_time.py``
+first run spends most of a minute compiling before its first step (``benchmarks/compile_time.py``
 measures it) and later runs load them in seconds.
 :class:`CompileNotice` listens to numba's ``"numba:compile"`` event, which numba raises only
 when a kernel is actually compiled (not when it is loaded from the cache), and calls

@@ -31,6 +31,7 @@ from floodsph.io.atomic_files import TEMP_PREFIX
 from floodsph.io.run_names import (
     BREACH_GLOB,
     CHECKPOINT_DIR,
+    CHECKPOINT_NAMES,
     FLUX_NAME,
     GAUGES_NAME,
     LOCK_NAME,
@@ -148,7 +149,7 @@ class RunFolder:
         """The folder of the latest checkpoint (a replacing run's first), or None."""
         for base in (self.path / STAGING_DIR, self.path):
             candidate = base / CHECKPOINT_DIR
-            if (candidate / "state.pkl").is_file():
+            if any((candidate / name).is_file() for name in CHECKPOINT_NAMES):
                 return candidate
         return None
 
@@ -191,7 +192,8 @@ class RunFolder:
         if not (self.resume and self.staged):
             return None
         source = self.path / SNAPSHOTS_NAME
-        resumed_in_place = (self.work / CHECKPOINT_DIR / "state.pkl").is_file()
+        resumed_in_place = any((self.work / CHECKPOINT_DIR / name).is_file()
+                               for name in CHECKPOINT_NAMES)
         return None if resumed_in_place or not source.exists() else source
 
     @property

@@ -5,9 +5,9 @@ both call (``floodsph.run.preflight``: the run folder, with nothing that is not 
 run's and no completed run unless replaced; the inputs -- terrain, particles, hydrographs,
 inflow sides, memory -- all before the run folder is touched) -> the folder is locked and
 opened (``floodsph.log``, ``scenario.resolved.toml``, ``run.json`` with status
-``"running"``) -> ``FloodModel`` (or the one of a checkpoint) -> ``Simulation`` with the
-mass-balance, progress, recorder and checkpoint callbacks -> maps, gauges and mass balance
-(written under temporary names, then renamed) -> quick-looks and ``report.html``
+``"running"``) -> ``FloodModel`` (on resume, given the checkpoint's state) -> ``Simulation``
+with the mass-balance, progress, recorder and checkpoint callbacks -> maps, gauges and mass
+balance (written under temporary names, then renamed) -> quick-looks and ``report.html``
 (``floodsph.output.report``) -> ``run.json`` last.
 
 ``run.json`` records every ending: ``"completed"``; ``"stopped"`` (``max_steps`` reached
@@ -142,12 +142,13 @@ def _run(scenario, inputs, folder, work, checkpoint, stop, opts) -> dict:
         write_manifest(work, manifest)
         log.info("run folder %s; %d particles, spacing %g m", folder.path, inputs.particles.n,
                  inputs.spacing_m)
-        if checkpoint is None:
-            from floodsph.model.from_scenario import build_model
+        from floodsph.model.from_scenario import build_model
 
-            model = build_model(scenario, inputs)
-        else:
-            model = checkpoint.model
+        model = build_model(scenario, inputs)
+        if checkpoint is not None:  # the fresh model takes the checkpoint's state
+            from floodsph.simulation.model_state import restore_model
+
+            restore_model(model, checkpoint.model, str(checkpoint.path))
             log.info("resumed from the checkpoint at t = %g s (step %d)", model.t, model.steps)
         _record_setup(manifest, model)
         mass, recorders, sim = _simulation(scenario, inputs, model, folder, opts, checkpoint,
@@ -302,13 +303,14 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
     from floodsph.simulation.schedules import IterationInterval, TimeInterval, WallTimeInterval
 
     work = folder.work
+    source = None if checkpoint is None else str(checkpoint.path)
     state = None if checkpoint is None else checkpoint.recorders
     mass = MassBalance(inputs.volume_initial_m3 + model.volume_seed_adjustment,
                        None if checkpoint is None else checkpoint.mass_rows)
     bar = Progress(scenario.end_time_s, enabled=opts.progress)
     recorders = Recorders(scenario, inputs.terrain, inputs.gauges, work, state=state,
                           snapshots_from=folder.finished_snapshots(),
-                          flux_lines=getattr(model, "flux_lines", None))
+                          flux_lines=model.flux_lines, source=source)
     callbacks = [
         (mass, TimeInterval(scenario.output.mass_balance_interval_s)),
         *recorders.callbacks(),
@@ -328,21 +330,30 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
     sim = Simulation(model, scenario.end_time_s, callbacks, max_steps=opts.max_steps,
                      should_stop=stop)
     if checkpoint is not None:
-        sim.restore(checkpoint.simulation)
+        from floodsph.simulation.state_arrays import conform
+
+        saved = conform(sim.state(), checkpoint.simulation, "simulation", source)
+        if len(saved["last_call"]) != len(callbacks):
+            raise InputError(f"{source}: the field simulation.last_call holds "
+                             f"{len(saved['last_call'])} callbacks, this run has "
+                             f"{len(callbacks)}")
+        sim.restore(saved)
     return mass, recorders, sim
 
 
 def _save(sim, scenario, threads, manifest, mass, recorders, work, wall_start) -> Path:
     """Write a checkpoint of the run now; ``manifest`` gets its time."""
     from floodsph.simulation.checkpoint import Checkpoint, save_checkpoint
+    from floodsph.simulation.model_state import model_state
 
     model = sim.model
-    checkpoint = Checkpoint(scenario=scenario.to_dict(), threads=threads, model=model,
+    checkpoint = Checkpoint(scenario=scenario.to_dict(), threads=threads,
+                            model=model_state(model),
                             simulation=sim.state(), recorders=recorders.state(),
                             mass_rows=list(mass.rows), resumed_from=manifest["resumed_from"],
                             wall_time_s=time.monotonic() - wall_start)
     started = time.monotonic()
-    path = save_checkpoint(work, checkpoint, model.terrain)
+    path = save_checkpoint(work, checkpoint)
     seconds = time.monotonic() - started
     manifest["checkpoint_time_s"] = float(model.t)
     manifest["checkpoint_bytes"] = path.stat().st_size

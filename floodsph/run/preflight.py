@@ -80,13 +80,17 @@ def _check_crest_walls(scenario: Scenario, inputs) -> None:
 
 def _resumable(folder: RunFolder, scenario: Scenario, inputs, threads: int | None):
     """The checkpoint to resume from, refused unless the scenario is the same."""
-    from floodsph.simulation.checkpoint import load_checkpoint, scenario_difference
+    from floodsph.simulation.checkpoint import (
+        load_checkpoint,
+        plain_scenario,
+        scenario_difference,
+    )
 
     directory = folder.checkpoint_dir()
     if directory is None:
         raise InputError(f"{folder.path}: no checkpoint to resume from")
-    checkpoint = load_checkpoint(directory, inputs.terrain)
-    where = scenario_difference(checkpoint.scenario, scenario.to_dict())
+    checkpoint = load_checkpoint(directory)
+    where = scenario_difference(checkpoint.scenario, plain_scenario(scenario.to_dict()))
     if where is not None:
         raise InputError(f"{scenario.path}: {where} differs from the checkpointed run's "
                          f"({directory}); only scenario.end_time_s may change on --resume")

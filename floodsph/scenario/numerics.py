@@ -87,7 +87,7 @@ SMOOTHING_EXCESS = 3.0
 sqrt(m / rho), not to the lattice value: on the coarse Ritter case (tests/sph/test_refine.py) and
 the first 60 s of Malpasset this beat both no relaxation (L1 2.3 %, front 252 m behind; 128 s
 of wall time) and relaxation to the lattice value (L1 3.7 %; 77 s): L1 1.8 %, front 19 m,
-50 s. The Ritter convergence study is sensitive to it (``workflows/ritter_sensitivity.py``)."""
+50 s. The Ritter convergence study is sensitive to it (``benchmarks/ritter_sensitivity.py``)."""
 
 
 @dataclass(frozen=True)
@@ -105,7 +105,7 @@ class Numerics:
     kappa : h0 / particle spacing. 1.2 (SWE-SPHysics' suggested value, ``docs/method.md`` §2): on
         the square lattice the water is seeded on, still water is then a minimum of the SPH
         energy and stays still; at 1.3, 1.25, 1.15 or 1.4-2 the lattice is a saddle of it and
-        a still lake stirs itself up within minutes (``workflows/lattice_stability.py``).
+        a still lake stirs itself up within minutes (``benchmarks/lattice_stability.py``).
     stabilisation : numerical dissipation, parameter-free Lax-Friedrichs (default) or Riemann.
     density_tol : Newton-Raphson tolerance on |R| / rho of the density solve.
     friction_depth_floor_m : depth floor [m] of the Manning term.

@@ -1,20 +1,27 @@
-"""Checkpoints: the whole state of a run, saved so that it can continue as if never stopped.
+"""Checkpoints: the state of a run as named arrays, so that it can continue as if never stopped.
 
-A checkpoint (``docs/run-folder.md``, "Checkpoints and ``--resume``") holds:
+A checkpoint (``docs/run-folder.md``, "Checkpoints and ``--resume``") is one file,
+``checkpoint/state.npz`` in the run folder: a numpy ``.npz`` archive of arrays named by dotted
+paths (``floodsph.simulation.state_arrays``), written under a temporary name and renamed over
+the previous one, so the previous checkpoint stays until the new one is complete. It holds
 
-* the model: particles, neighbour and wall lists, boundary and inflow state, refinement
-  state, the clock and the counters (the terrain is not stored: it is read again from the
-  scenario's DEM, and must be the same);
-* the recorders: the envelope maps, the gauge rows, the number of snapshot frames;
-* the mass-balance rows and the simulation loop's own state (when each callback last ran
-  and is next due);
-* the resolved scenario, the floodsph version and the thread count it was written with.
+* ``format`` (:data:`FORMAT`), ``floodsph_version``, ``threads`` (numba threads),
+  ``wall_time_s`` (wall time spent so far) and ``resumed_from`` (the checkpoint times the
+  run had been resumed from);
+* ``scenario``: the resolved scenario as canonical JSON (:func:`canonical_json`), and
+  ``scenario_sha256``, the SHA-256 of that text;
+* ``model.*``: the model's state (``floodsph.simulation.model_state``): particles, neighbour
+  and wall lists, boundary and inflow state, refinement state, flux lines, the clock and the
+  counters. The terrain, walls and boundaries themselves are not stored: a resumed run makes
+  them again from the scenario and its inputs, which must be the same;
+* ``recorders.*``: the envelope maps, the gauge rows, the number of snapshot frames;
+* ``simulation.*``: the simulation loop's own state (when each callback last ran and is next
+  due); ``mass_rows``: the mass-balance rows.
 
-It is one file, ``checkpoint/state.pkl`` in the run folder, a Python pickle (protocol 5)
-written under a temporary name and renamed over the previous one, so the previous checkpoint
-stays until the new one is complete. A pickle runs code when it is read: only resume from a
-run folder you trust, as with any file your runs wrote. A checkpoint is read only by the same
-floodsph version that wrote it.
+It is read with ``numpy.load(..., allow_pickle=False)``: reading it runs no code, and any
+program that reads ``.npz`` files can read it. A checkpoint is read only by the same floodsph
+version that wrote it; the pickled checkpoints of format 4 and before (``state.pkl``) are
+refused, never read.
 
 Resuming from the same state, with the same thread count, repeats the same arithmetic in the
 same order (the neighbour lists are part of the state), so the resumed run's maps, gauges and
@@ -23,37 +30,48 @@ mass balance equal the uninterrupted run's bit for bit.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
-import pickle
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
+
+import numpy as np
 
 from floodsph._version import __version__
 from floodsph.errors import InputError
 from floodsph.io.atomic_files import atomic_path
-from floodsph.io.run_names import CHECKPOINT_DIR
+from floodsph.io.run_names import CHECKPOINT_DIR, CHECKPOINT_NAME, PICKLED_CHECKPOINT_NAME
+from floodsph.simulation.state_arrays import expect_fields, flatten, unflatten
 
-STATE_NAME = "state.pkl"
-FORMAT = 4
+FORMAT = 5
 """Checkpoint layout; 2 adds the particles' velocity gradient, 3 their level offset and seeded
-level, 4 their flag of still water held by its banks (``floodsph.model.particles``)."""
-_TERRAIN = "terrain"
+level, 4 their flag of still water held by its banks (``floodsph.model.particles``), 5 is
+named arrays in ``state.npz`` instead of a pickle in ``state.pkl``."""
+SCENARIO = "scenario"
+"""The name of the scenario's canonical JSON text in the file."""
+FIELDS = ("format", "floodsph_version", "scenario_sha256", SCENARIO, "threads", "wall_time_s",
+          "resumed_from", "model", "simulation", "recorders", "mass_rows")
+"""The top-level fields of a checkpoint (module docstring)."""
 
 
 @dataclass
 class Checkpoint:
     """The state of a run at one step (module docstring).
 
-    ``scenario``: the resolved scenario (``Scenario.to_dict``); ``threads``: numba threads;
-    ``model``: the FloodModel; ``simulation``: ``Simulation.state()``; ``recorders``:
-    ``Recorders.state()``; ``mass_rows``: the mass-balance rows; ``resumed_from``: the
-    checkpoint times the run had been resumed from; ``wall_time_s``: wall time spent so far.
+    ``scenario``: the resolved scenario (``Scenario.to_dict``, as JSON reads it back:
+    :func:`plain_scenario`); ``threads``: numba threads; ``model``:
+    ``floodsph.simulation.model_state.model_state``; ``simulation``: ``Simulation.state()``;
+    ``recorders``: ``Recorders.state()``; ``mass_rows``: the mass-balance rows;
+    ``resumed_from``: the checkpoint times the run had been resumed from; ``wall_time_s``: wall
+    time spent so far; ``path``: the file it was read from (None before it is written).
     """
 
     scenario: dict
     threads: int
-    model: Any
+    model: dict
     simulation: dict
     recorders: dict
     mass_rows: list
@@ -61,64 +79,114 @@ class Checkpoint:
     wall_time_s: float = 0.0
     floodsph_version: str = __version__
     format: int = FORMAT
+    path: Path | None = None
 
     @property
     def t(self) -> float:
         """Simulated time of the checkpoint [s]."""
-        return float(self.model.t)
+        return float(self.model["t"])
 
 
-class _Pickler(pickle.Pickler):
-    """Stores the terrain as a reference, to be given back by :class:`_Unpickler`."""
-
-    def __init__(self, file, terrain):
-        super().__init__(file, protocol=5)
-        self._terrain = terrain
-
-    def persistent_id(self, obj):
-        return _TERRAIN if obj is self._terrain else None
+def canonical_json(scenario: dict) -> str:
+    """The resolved scenario as one canonical JSON text (sorted keys, no spaces), the text
+    that ``scenario_sha256`` hashes."""
+    return json.dumps(scenario, sort_keys=True, separators=(",", ":"), ensure_ascii=False,
+                      allow_nan=True)
 
 
-class _Unpickler(pickle.Unpickler):
-    def __init__(self, file, terrain):
-        super().__init__(file)
-        self._terrain = terrain
-
-    def persistent_load(self, pid):
-        if pid != _TERRAIN:
-            raise pickle.UnpicklingError(f"unknown reference {pid!r}")
-        return self._terrain
+def plain_scenario(scenario: dict) -> dict:
+    """``scenario`` as a checkpoint gives it back (tuples as lists), for comparisons."""
+    return json.loads(canonical_json(scenario))
 
 
-def save_checkpoint(folder: Path, checkpoint: Checkpoint, terrain) -> Path:
-    """Write ``checkpoint`` to ``folder/checkpoint/state.pkl`` atomically; return its path."""
+def scenario_sha256(text: str) -> str:
+    """The SHA-256 of a scenario's canonical JSON text, in hex."""
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def save_checkpoint(folder: Path, checkpoint: Checkpoint) -> Path:
+    """Write ``checkpoint`` to ``folder/checkpoint/state.npz`` atomically; return its path."""
     directory = Path(folder) / CHECKPOINT_DIR
     directory.mkdir(exist_ok=True)
-    target = directory / STATE_NAME
+    target = directory / CHECKPOINT_NAME
+    text = canonical_json(checkpoint.scenario)
+    arrays = flatten({
+        "format": checkpoint.format,
+        "floodsph_version": checkpoint.floodsph_version,
+        "scenario_sha256": scenario_sha256(text),
+        "threads": checkpoint.threads,
+        "wall_time_s": checkpoint.wall_time_s,
+        "resumed_from": list(checkpoint.resumed_from),
+        "model": checkpoint.model,
+        "simulation": checkpoint.simulation,
+        "recorders": checkpoint.recorders,
+        "mass_rows": list(checkpoint.mass_rows),
+    })
+    arrays[SCENARIO] = np.asarray(text)
     with atomic_path(target) as tmp, open(tmp, "wb") as f:
-        _Pickler(f, terrain).dump(checkpoint)
+        np.savez(f, **cast(dict[str, Any], arrays))
         f.flush()
         os.fsync(f.fileno())
     return target
 
 
-def load_checkpoint(directory: Path, terrain) -> Checkpoint:
-    """Read the checkpoint in ``directory`` (a ``checkpoint/`` folder) onto ``terrain``."""
-    path = Path(directory) / STATE_NAME
-    try:
-        with open(path, "rb") as f:
-            checkpoint = _Unpickler(f, terrain).load()
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError) as exc:
-        raise InputError(f"{path}: the checkpoint cannot be read ({exc})") from None
-    if not isinstance(checkpoint, Checkpoint):
-        raise InputError(f"{path}: not a floodsph checkpoint")
-    if checkpoint.format != FORMAT:
-        raise InputError(f"{path}: a checkpoint of format {checkpoint.format}; this floodsph "
-                         f"reads format {FORMAT} only: run the scenario again with --overwrite")
-    if checkpoint.floodsph_version != __version__:
-        raise InputError(f"{path}: written by floodsph {checkpoint.floodsph_version}, this is "
+def load_checkpoint(directory: Path) -> Checkpoint:
+    """Read the checkpoint in ``directory`` (a ``checkpoint/`` folder).
+
+    Raises
+    ------
+    InputError
+        No checkpoint, a pickled checkpoint of format 4 or before, a file that cannot be
+        read (truncated, changed), another format or floodsph version, or a field missing,
+        extra or of the wrong kind.
+    """
+    path = Path(directory) / CHECKPOINT_NAME
+    pickled = Path(directory) / PICKLED_CHECKPOINT_NAME
+    if not path.is_file() and pickled.is_file():
+        raise InputError(f"{pickled}: a checkpoint of format 4 or before (a Python pickle, "
+                         f"which is never read); this floodsph reads format {FORMAT} only: "
+                         "run the scenario again with --overwrite")
+    arrays = _read_arrays(path)
+    source = str(path)
+    if "format" not in arrays:
+        raise InputError(f"{path}: not a floodsph checkpoint (it has no format)")
+    found = arrays["format"]
+    if found.ndim != 0 or found.dtype.kind not in "iu" or int(found) != FORMAT:
+        raise InputError(f"{path}: a checkpoint of format {found}; this floodsph reads "
+                         f"format {FORMAT} only: run the scenario again with --overwrite")
+    tree = unflatten(arrays, source)
+    expect_fields(tree, FIELDS, "", source)
+    if tree["floodsph_version"] != __version__:
+        raise InputError(f"{path}: written by floodsph {tree['floodsph_version']}, this is "
                          f"{__version__}; resume it with that version")
-    return checkpoint
+    if scenario_sha256(str(arrays[SCENARIO])) != tree["scenario_sha256"]:
+        raise InputError(f"{path}: the scenario stored in the checkpoint does not match its "
+                         "scenario_sha256: the file was changed")
+    for name, kind in (("threads", int), ("wall_time_s", float), ("resumed_from", list),
+                       ("model", dict), ("simulation", dict), ("recorders", dict),
+                       ("mass_rows", list), (SCENARIO, dict)):
+        value = tree[name]
+        if not isinstance(value, kind) or (kind is float and isinstance(value, bool)):
+            raise InputError(f"{path}: the field {name} is not a {kind.__name__}")
+    if not isinstance(tree["model"].get("t"), float):
+        raise InputError(f"{path}: the field model.t is missing or not a number")
+    if not all(isinstance(row, list) for row in tree["mass_rows"]):
+        raise InputError(f"{path}: the field mass_rows is not a list of rows")
+    return Checkpoint(scenario=tree[SCENARIO], threads=tree["threads"], model=tree["model"],
+                      simulation=tree["simulation"], recorders=tree["recorders"],
+                      mass_rows=[tuple(row) for row in tree["mass_rows"]],
+                      resumed_from=tree["resumed_from"], wall_time_s=tree["wall_time_s"],
+                      floodsph_version=tree["floodsph_version"], format=FORMAT, path=path)
+
+
+def _read_arrays(path: Path) -> dict[str, np.ndarray]:
+    """Every array of the ``.npz`` file ``path``, read without unpickling anything."""
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            return {name: npz[name] for name in npz.files}
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile,
+            TypeError) as exc:
+        raise InputError(f"{path}: the checkpoint cannot be read ({exc})") from None
 
 
 def scenario_difference(saved: dict, current: dict, path: str = "") -> str | None:

@@ -52,6 +52,10 @@ class FluxLines:
         Each line's name and vertices in local coordinates [m].
     """
 
+    STATE = ("since_row", "forward", "backward", "t_last", "rows")
+    """What changes during a run (``floodsph.simulation.state_arrays``): the volumes counted
+    and the rows recorded."""
+
     def __init__(self, lines):
         self.names = tuple(name for name, _ in lines)
         seg, owner = [], []

@@ -21,6 +21,7 @@ import numpy as np
 from floodsph.io.run_names import FLUX_NAME, GAUGES_NAME, SNAPSHOTS_NAME
 from floodsph.scenario.config import Scenario
 from floodsph.simulation.schedules import TimeInterval, TimeList, time_tolerance
+from floodsph.simulation.state_arrays import conform
 
 SNAPSHOTS_PART = SNAPSHOTS_NAME + ".part"
 
@@ -30,18 +31,23 @@ class Recorders:
     ``floodsph.simulation.flux.FluxLines``, which carries its own state through a checkpoint)
     and snapshots (``snapshot_interval_s > 0`` or ``snapshot_times_s``).
 
-    ``state`` (:meth:`state` of an earlier run) continues that run's records; its snapshot
-    frames are read from ``snapshots_from`` (default: this run's own ``snapshots.nc.part``).
+    ``state`` (:meth:`state` of an earlier run, as a checkpoint gives it back) continues that
+    run's records; its snapshot frames are read from ``snapshots_from`` (default: this run's
+    own ``snapshots.nc.part``). ``source``: the file ``state`` was read from, for the
+    message of a field missing or ill-formed (``floodsph.errors.InputError``).
     """
 
     def __init__(self, scenario: Scenario, terrain, gauge_points, out: Path,
                  state: dict | None = None, snapshots_from: Path | None = None,
-                 flux_lines=None):
+                 flux_lines=None, source: str | None = None):
         from floodsph.output.envelopes import Envelopes
         from floodsph.output.grid import OutputGrid
 
         self.scenario = scenario
         self.out = Path(out)
+        source = source or "checkpoint"
+        frames = 0 if state is None else conform(0, state.get("snapshot_frames"),
+                                                 "recorders.snapshot_frames", source)
         wet = scenario.output.wet_threshold_m
         self.grid = OutputGrid.from_terrain(terrain, scenario.output.resolution_m)
         self.envelopes = Envelopes(self.grid, wet_threshold=wet)
@@ -58,13 +64,14 @@ class Recorders:
 
             self.snapshots = SnapshotWriter(
                 self.out / SNAPSHOTS_PART, self.grid, scenario=scenario.to_dict(),
-                wet_threshold=wet, keep_frames=0 if state is None else state["snapshot_frames"],
+                wet_threshold=wet, keep_frames=frames,
                 source=snapshots_from, start=scenario.start,
             )
         if state is not None:
+            state = conform(self.state(), state, "recorders", source)
             self.envelopes.restore(state["envelopes"])
             if self.gauges is not None:
-                self.gauges.rows = list(state["gauge_rows"])
+                self.gauges.rows = [tuple(row) for row in state["gauge_rows"]]
                 self.gauges.t_last = state["gauge_t_last"]
 
     def state(self) -> dict:

@@ -330,7 +330,7 @@ def _subtract_images(acc, i, nstart, nbr, blocked, x, y, u, v, m, rho, h, coef, 
     term is zero and is skipped; so is an image that does not apply (its terms are zero).
     The pair term appears once here for every kind of image, and the force kernel calls this
     from one place: with a copy of the pair term for each image kind and each call, the
-    kernel's cold compile took 66 s on two cores (``workflows/compile_time.py``).
+    kernel's cold compile took 66 s on two cores (``benchmarks/compile_time.py``).
     """
     hi = h[i]
     for q in range(nstart[i] - 1, nstart[i + 1]):

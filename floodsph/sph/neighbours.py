@@ -277,6 +277,11 @@ class NeighbourList:
         end a step. Default: every particle.
     """
 
+    STATE = ("skin", "complete", "reach", "rows", "x_built", "y_built", "h_built", "start",
+             "nbr")
+    """The lists as a checkpoint holds them (``floodsph.simulation.state_arrays``): resuming
+    with the lists of the interrupted run, not new ones, keeps the pairs in their order."""
+
     def __init__(self, x, y, h, skin=0.1, rows=None):
         n = x.shape[0]
         self.skin = skin

@@ -26,7 +26,7 @@ the bed sampled one smoothing length beyond i in the push's direction (about a p
 spacing: the neighbouring cell of the finite-volume reconstruction), and the head raised by
 the run-up height (v . e)^2 / (2 g) of water moving towards the edge (Bernoulli), so that a
 front running over a bump keeps its push while still water (v = 0) is balanced. Measured on
-the sample valley's dam break against ANUGA's maximum-depth map (``workflows/
+the sample valley's dam break against ANUGA's maximum-depth map (``benchmarks/
 versus_grid_code.py``, CSI at 0.1 m, kappa = 1.3; 0.958 with no balance): 0.959 as here,
 0.957 without the run-up height, 0.949 with the bed sampled at 2 h_i (bumps ahead stopped
 thin fronts); 0.972 as here with the default kappa = 1.2.
@@ -41,7 +41,7 @@ so that at a lake's shore (d_i* = 0) the force is -g grad d, which balances -g g
 flat bed, and wherever the bed beyond the edge lies lower (a front running downhill),
 d_i* = d_i and the force is the variational one, which conserves momentum. Supports too
 empty to renormalise (det M_i < ``DET_MIN``) keep D_i. Particles with a full support,
-|E_i| h_i / g < ``FULL_SUPPORT`` (in the dam break of ``workflows/speed_vs_error.py``'s
+|E_i| h_i / g < ``FULL_SUPPORT`` (in the dam break of ``benchmarks/speed_vs_error.py``'s
 throughput block: below 0.0023 for nine particles in ten, 0.14 for the top one in a hundred,
 at its edges), are left as they are: there E_i and M_i - I vanish. The same correction is
 applied with the Riemann pressure option, whose still-water pressure is the hydrostatic one.

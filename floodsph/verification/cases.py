@@ -3,7 +3,7 @@
 Each case builds a ``FloodModel`` on an analytic bed with ``Terrain.from_function``, runs it
 and returns the error against the exact solution of ``floodsph.verification.exact``, with the cost
 counters a speed-against-error study needs and the depth profile at the end time. Used by the
-slow tests, ``workflows/speed_vs_error.py`` and ``workflows/validation_pages.py``.
+slow tests, ``benchmarks/speed_vs_error.py`` and ``benchmarks/validation_pages.py``.
 
 Errors are measured on the Shepard-interpolated depth field of the output maps
 (``floodsph.output.rasterise.interpolate``, dry = 0 where the kernel support is below half):

@@ -81,7 +81,7 @@ class WallIndex:
     radius is below it has no near segment and skips the bucket walk. Each bucket of level 0
     also lists its candidates, every segment whose box widened by ``near_radius``
     (``NEAR_BUCKETS`` buckets) overlaps it: a particle of that reach or less tests them alone,
-    without the walk (on the dam break of ``workflows/step_cost.py`` at 4,000 particles, the
+    without the walk (on the dam break of ``benchmarks/step_cost.py`` at 4,000 particles, the
     lists took 0.24 ms a step instead of 0.79).
     """
 

@@ -23,7 +23,7 @@ to walls that are in still water and enclosed (below) are therefore
    was seeded (:func:`limited_move`), until |a_i| < ``SETTLED`` g or for ``SETTLE_STEPS``
    rounds. Each seed's own step cfl h_i / sqrt(g d_i), longer than the model's where the
    water is deeper or h longer elsewhere, settled the building of
-   ``workflows/still_water_at_walls.py`` worse: 95th-percentile speed 0.108 m/s after 200 s,
+   ``benchmarks/still_water_at_walls.py`` worse: 95th-percentile speed 0.108 m/s after 200 s,
    against 0.062;
 2. matched: m_i <- m_i d*_i / d_i (Jacobi), with d* the seeded depth and d the SPH depth of
    the density solve, until max |d_i / d*_i - 1| < ``TOLERANCE`` or for ``ROUNDS`` rounds,
@@ -56,7 +56,7 @@ their near list, out of open boundaries' zones, that are
 Each settling round and each matching round solves density and forces for the seeds and
 ``RINGS`` rings of their listed neighbours alone (:func:`neighbourhood`): the other particles
 do not move, and their density does not change. In a 2 km x 1.5 km lake around a turned
-building (118,400 particles, 4,612 seeds, ``workflows/still_water_at_walls.py``) this cut the
+building (118,400 particles, 4,612 seeds, ``benchmarks/still_water_at_walls.py``) this cut the
 set-up from the time of 321 steps to that of 101, with the seeds ending where they did.
 
 The matching changes the seeded volume (+40 m3, 0.04 %, in the lake above); the model reports

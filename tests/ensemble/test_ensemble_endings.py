@@ -72,7 +72,7 @@ def test_a_signal_ends_the_ensemble_and_its_running_member_interrupted(tmp_path,
     assert [rows[m]["status"] for m in ("m0000", "m0001")] == ["interrupted", "not run"]
     member = json.loads((out / "members" / "m0000" / "run.json").read_text())
     assert member["status"] == "interrupted"
-    assert (out / "members" / "m0000" / "checkpoint" / "state.pkl").is_file()
+    assert (out / "members" / "m0000" / "checkpoint" / "state.npz").is_file()
     assert member["threads"] == 1  # NUMBA_NUM_THREADS=1 honoured with --workers 1
 
 

@@ -8,8 +8,10 @@ Checked in ``floodsph/**/*.py`` and ``docs/**/*.md``:
   notes");
 * every ``docs/NAME.md`` exists, and so does every relative Markdown link between the docs;
 * every ``docs/method.md §N`` (or ``§N.M``) is a numbered heading of ``docs/method.md``;
-* every ``floodsph/....py`` path exists, and every dotted ``floodsph.package.module[.name]``
-  names a module and, after it, a name that module defines at its top level.
+* every ``floodsph/....py``, ``workflows/....py`` and ``benchmarks/....py`` path exists (a
+  script moved between the user's ``workflows/`` and the studies' ``benchmarks/`` is cited
+  where it now is), and every dotted ``floodsph.package.module[.name]`` names a module and,
+  after it, a name that module defines at its top level.
 """
 
 from __future__ import annotations
@@ -114,7 +116,7 @@ def problems() -> list[str]:
         for pos, number in cited_sections(text, own=path == METHOD):
             if number not in sections:
                 found.append(f"{_where(path, text, pos)}: docs/method.md has no §{number}")
-        for m in re.finditer(r"floodsph/[\w/]+\.py", text):
+        for m in re.finditer(r"(?<![\w/])(?:floodsph|workflows|benchmarks)/[\w/]+\.py", text):
             if not (ROOT / m.group(0)).is_file():
                 found.append(f"{_where(path, text, m.start())}: no file {m.group(0)}")
         for m in re.finditer(r"floodsph(?:\.[A-Za-z_]\w*)+", text):

@@ -256,7 +256,7 @@ def test_each_stop_signal_writes_a_checkpoint_then_interrupted(scenario_file, tm
                      callbacks=[signal_at(3, signum)])
     assert m["status"] == "interrupted"
     assert signal.Signals(signum).name in m["error"]
-    assert (out / "checkpoint" / "state.pkl").is_file()
+    assert (out / "checkpoint" / "state.npz").is_file()
     assert manifest(out)["checkpoint_time_s"] == m["sim_time_s"] > 0
     assert "max_depth.tif" not in contract_names(out)
 
@@ -278,7 +278,7 @@ def test_sigterm_from_outside_ends_the_command_with_status_130(write_scenario, t
     assert "SIGTERM" in stderr and "--resume" in stderr
     m = manifest(out)
     assert m["status"] == "interrupted" and m["checkpoint_time_s"] > 0
-    assert (out / "checkpoint" / "state.pkl").is_file()
+    assert (out / "checkpoint" / "state.npz").is_file()
 
 
 def test_a_full_disk_while_writing_the_maps_fails_cleanly(scenario_file, tmp_path,

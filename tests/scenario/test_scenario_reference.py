@@ -13,7 +13,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
-from conftest import load_workflow
+from conftest import load_script
 
 from floodsph.errors import InputError
 from floodsph.scenario.keys import TABLES
@@ -21,7 +21,7 @@ from floodsph.scenario.reader import scenario_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "scenario-reference.md"
-generator = load_workflow("scenario_reference", ROOT / "workflows" / "scenario_reference.py")
+generator = load_script("scenario_reference", ROOT / "workflows" / "scenario_reference.py")
 UNKNOWN = "zz_no_such_key"
 REGENERATE = "re-run `python workflows/scenario_reference.py` and commit docs/scenario-reference.md"
 

@@ -66,7 +66,7 @@ def test_ritter_convergence_meets_targets():
 @pytest.mark.xfail(strict=True, reason="split+coalesce: L1 0.86 / 0.57 / 0.29 % at 10 / 5 / "
                    "2.5 m (order 0.78); front 23 m behind, 3 m ahead, 6 m behind (two spacings "
                    "only at 5 m); the targets lie within the split-and-merge noise "
-                   "(workflows/ritter_sensitivity.py)")
+                   "(benchmarks/ritter_sensitivity.py)")
 def test_refined_ritter_convergence_meets_targets():
     results = [cases.ritter(dx, refinement=Refinement.SPLIT_COALESCE) for dx in (10.0, 5.0, 2.5)]
     errors = [r.l1 for r in results]

@@ -11,11 +11,11 @@ import math
 from pathlib import Path
 
 import numpy as np
-from conftest import load_workflow
+from conftest import load_script
 from ensemble_cases import ensemble_text, write_case
 
 REPO = Path(__file__).resolve().parents[2]
-convergence = load_workflow("ensemble_convergence",
+convergence = load_script("ensemble_convergence",
                             REPO / "workflows" / "ensemble_convergence.py")
 
 
