@@ -1,9 +1,10 @@
 """The golden regression cases: small runs whose numbers are stored in ``tests/golden/``.
 
 The cases run with the default numerics (the balanced momentum), and the three analytic ones
-also with the variational momentum. Each case returns plain data (lists of floats, ints): depth profiles, step and refinement
-counters, mass, gauge values. ``python tests/golden_cases.py`` regenerates the stored files;
-do that only for a change that is meant to move the numbers, and say why in its commit.
+also with the variational momentum. Each case returns plain data (lists of floats, ints):
+depth profiles, step and refinement counters, mass, gauge values.
+``python tests/golden_cases.py`` regenerates the stored files; do that only for a change that
+is meant to move the numbers, and say why in its commit.
 Cases run with 2 numba threads, the CI machine's count.
 """
 
