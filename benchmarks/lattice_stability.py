@@ -47,7 +47,7 @@ from numba import njit
 from floodsph.inputs.initial_water import seed_particles
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
-from floodsph.scenario.numerics import Numerics
+from floodsph.scenario.numerics import Momentum, Numerics
 from floodsph.sph.kernels import w_cubic
 
 
@@ -112,15 +112,18 @@ def lowest_curvature(kappa: float, patch: int, eps: float = 2e-3) -> float:
 
 
 def still_lake(kappa: float, end_time: float, side: float = 1000.0, spacing: float = 20.0,
-               perturbation: float = 0.02, seed: int = 1, every: float = 80.0):
+               perturbation: float = 0.02, seed: int = 1, every: float = 80.0,
+               momentum: Momentum = Momentum.VARIATIONAL):
     """(t [s], max particle speed [m/s]) every ``every`` s of a 10 m still lake on a flat,
-    frictionless, closed square of ``side`` [m] (module docstring)."""
+    frictionless, closed square of ``side`` [m] (module docstring), under the variational
+    momentum whose energy the study's Hessian is, unless ``momentum`` says otherwise."""
     terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0.0, side), (0.0, side), 10.0)
     p = seed_particles(terrain, np.full(terrain.shape, 10.0), spacing, kappa)
     rng = np.random.default_rng(seed)
     p.x[:p.n] += rng.normal(0.0, perturbation, p.n)
     p.y[:p.n] += rng.normal(0.0, perturbation, p.n)
-    model = set_up_model(terrain, p, Numerics(particle_spacing_m=spacing, kappa=kappa))
+    model = set_up_model(terrain, p, Numerics(particle_spacing_m=spacing, kappa=kappa,
+                                              momentum=momentum))
     out = []
     for t_end in np.arange(every, end_time + 1e-9, every):
         while model.t < t_end - 1e-9:

@@ -100,7 +100,12 @@ from floodsph import __version__ as FLOODSPH_VERSION  # noqa: E402
 from floodsph.constants import GRAVITY  # noqa: E402
 from floodsph.output.tables import markdown, write_csv  # noqa: E402
 from floodsph.run.pipeline import set_threads  # noqa: E402
-from floodsph.scenario.numerics import Refinement, Stabilisation, TimeStepping  # noqa: E402
+from floodsph.scenario.numerics import (  # noqa: E402
+    Momentum,
+    Refinement,
+    Stabilisation,
+    TimeStepping,
+)
 from floodsph.verification import cases, exact, metrics  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
@@ -126,8 +131,10 @@ class Mode:
     @property
     def numerics(self) -> dict:
         """The mode as fields of ``Numerics``."""
+        momentum = (Momentum.BALANCED if self.stabilisation is Stabilisation.LAX_FRIEDRICHS
+                    else Momentum.VARIATIONAL)  # the other stabilisations need "variational"
         return {"refinement": self.refinement, "time_stepping": self.time_stepping,
-                "stabilisation": self.stabilisation}
+                "stabilisation": self.stabilisation, "momentum": momentum}
 
 
 MODES = (Mode("none, global", Refinement.NONE, TimeStepping.GLOBAL),

@@ -2,7 +2,8 @@
 still water and, given two runs, the Malpasset maps.
 
 What it measures, for ``numerics.stabilisation`` = "lax-friedrichs" (the default) and "muscl"
-(``floodsph.sph.forces.reconstructed_jump``):
+(``floodsph.sph.forces.reconstructed_jump``), both with ``numerics.momentum = "variational"``
+(which "muscl" needs):
 
 * the analytic cases of ``floodsph.verification.cases`` (Ritter and Stoker at 10 and 5 m,
   Thacker at 200 and 100 m) in four modes: no refinement or split+coalesce, each with one
@@ -11,7 +12,8 @@ What it measures, for ``numerics.stabilisation`` = "lax-friedrichs" (the default
 * with ``--still-water``, the quick still-water benchmark (``still_water.py --quick``) with
   each stabilisation: the worst speeds of each case over 60 s and its small dam breaks;
 * with ``--malpasset LF_DIR MUSCL_DIR``, two results folders of
-  ``malpasset/run_malpasset.py --sea sink`` (the second run with ``--stabilisation muscl``):
+  ``malpasset/run_malpasset.py --sea sink --momentum variational`` (the second run with
+  ``--stabilisation muscl``):
   the maximum-depth maps compared with ``floodsph.output.compare`` (CSI, depth RMSE and bias
   over the cells wet in both, wet = depth > 0.1 m), the arrival times at S6-S14 and the wall
   times of the two runs.
@@ -40,7 +42,12 @@ import provenance  # noqa: E402
 
 from floodsph.output.tables import markdown  # noqa: E402
 from floodsph.run.pipeline import set_threads  # noqa: E402
-from floodsph.scenario.numerics import Refinement, Stabilisation, TimeStepping  # noqa: E402
+from floodsph.scenario.numerics import (  # noqa: E402
+    Momentum,
+    Refinement,
+    Stabilisation,
+    TimeStepping,
+)
 from floodsph.verification import cases  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
@@ -61,7 +68,8 @@ def analytic_rows() -> list[dict]:
         for refinement, stepping in MODES:
             for scheme in SCHEMES:
                 cases.CASES[name](40.0 if name != "thacker" else 400.0, refinement=refinement,
-                                  time_stepping=stepping, stabilisation=scheme)
+                                  time_stepping=stepping, stabilisation=scheme,
+                                  momentum=Momentum.VARIATIONAL)
     rows = []
     for name, spacings in RESOLUTIONS.items():
         for dx in spacings:
@@ -70,7 +78,7 @@ def analytic_rows() -> list[dict]:
                        "mode": f"{refinement.value}, {stepping.value}"}
                 for scheme, tag in SCHEMES.items():
                     r = cases.CASES[name](dx, refinement=refinement, time_stepping=stepping,
-                                          stabilisation=scheme)
+                                          stabilisation=scheme, momentum=Momentum.VARIATIONAL)
                     row[f"L1 % {tag}"] = 100.0 * r.l1
                     row[f"front m {tag}"] = r.front_error_m
                     row[f"wall s {tag}"] = r.wall_s
@@ -89,7 +97,8 @@ def still_water_rows(folder: Path) -> tuple[list[dict], list[dict]]:
     out = {}
     for scheme in SCHEMES:
         bench = still_water.run_benchmark(still_water.parse_args(
-            ["--quick", "--stabilisation", scheme.value, "--out", str(folder / scheme.value)]))
+            ["--quick", "--stabilisation", scheme.value, "--momentum", "variational", "--out",
+             str(folder / scheme.value)]))
         out[scheme] = ({r.case.label: still_water.still_row(r) for r in bench.still},
                        {row["case"]: row for row in still_water.dam_break_rows(bench.dam_break)})
     rows = []

@@ -120,7 +120,9 @@ class Probe:
         speed = np.hypot(p.u, p.v)
         case = self.case
         eta = model.surface_levels()
-        if eta is None:  # the variational momentum: the summed depth on the bed
+        if eta is not None:  # the balanced momentum: maps report the level less the bed
+            self.particles["level"] = eta.copy()
+        else:  # the variational momentum: the summed depth on the bed
             eta = model.depth() + model.bed[: p.n, 0]
         level = (np.abs(eta - case.level_m) if case.level_m is not None and p.n
                  else np.array([math.nan]))
@@ -235,7 +237,8 @@ def reservoir_figures(run: CaseRun) -> dict:
 
 def dam_break_figures(run: CaseRun) -> dict:
     """L1 of the mean depth profile against Ritter, of the lines next to the walls and of
-    the middle lines, and the front error, at the end time."""
+    the middle lines, and the front error, at the end time; the depth as the maps show it
+    (under the balanced momentum, the particles' level less the bed)."""
     from floodsph.output.rasterise import interpolate
     from floodsph.verification import exact, metrics
 
@@ -245,8 +248,10 @@ def dam_break_figures(run: CaseRun) -> dict:
     S, N = np.meshgrid(s, np.asarray(LINE_FRACTIONS) * ch.width)
     X, Y = ch.to_world(S.ravel(), N.ravel())
     x0, y0 = run.probe.origin
+    level = p.get("level")  # as the maps see it: the level less the (flat, zero) bed
     d = interpolate(X - x0, Y - y0, p["x"], p["y"], p["u"], p["v"], p["m"], p["rho"],
-                    p["h"])[0]
+                    p["h"], level=level,
+                    bed=None if level is None else np.zeros_like(X))[0]
     d = np.nan_to_num(d).reshape(S.shape)
     d_exact, _ = exact.ritter(s, ch.t_end, ch.d0, x_dam=ch.x_dam)
     mean = d.mean(axis=0)

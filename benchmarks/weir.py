@@ -40,7 +40,7 @@ from floodsph.inputs.initial_water import particles_at
 from floodsph.io.hydrograph import Hydrograph
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
-from floodsph.scenario.numerics import Numerics, TimeStepping
+from floodsph.scenario.numerics import Momentum, Numerics, TimeStepping
 
 WIDTH = 5.0
 BASIN = 10.0
@@ -65,12 +65,13 @@ def lattice(x0, x1, dx):
     return x.ravel(), y.ravel()
 
 
-def channel(q_in: float, crest2: float | None, dx: float):
+def channel(q_in: float, crest2: float | None, dx: float,
+            momentum: Momentum = Momentum.BALANCED):
     """The model of a case and its weirs (module docstring)."""
     q = q_in / WIDTH
     length = 3 * BASIN if crest2 is not None else 2 * BASIN
     terrain = Terrain.from_function(lambda x, y: 0.0 * x, (0.0, length), (0.0, WIDTH), 0.5)
-    num = Numerics(particle_spacing_m=dx, time_stepping=TimeStepping.GLOBAL)
+    num = Numerics(particle_spacing_m=dx, time_stepping=TimeStepping.GLOBAL, momentum=momentum)
     walls = [np.array([[BASIN, 0.0], [BASIN, WIDTH]])]
     weirs = [Weir(Crest(walls[0], CREST), dx, num.kappa, name="walls[0]")]
     x, y = lattice(0.0, BASIN, dx)
@@ -101,9 +102,10 @@ def band_level(model, x0: float, x1: float) -> float:
     return float(np.average(p.rho[band], weights=p.m[band] / p.rho[band]) / RHO_WATER)
 
 
-def run_case(kind: str, q_in: float, crest2: float | None, dx: float, t_end: float) -> dict:
+def run_case(kind: str, q_in: float, crest2: float | None, dx: float, t_end: float,
+             momentum: Momentum = Momentum.BALANCED) -> dict:
     started = time.perf_counter()
-    model, weirs = channel(q_in, crest2, dx)
+    model, weirs = channel(q_in, crest2, dx, momentum)
     half = 0.5 * t_end
     while model.t < half - 1e-9:
         model.step(half - model.t)
@@ -129,11 +131,12 @@ def run_case(kind: str, q_in: float, crest2: float | None, dx: float, t_end: flo
             "wall_s": time.perf_counter() - started}
 
 
-def table(rows: list[dict], dx: float, t_end: float) -> str:
+def table(rows: list[dict], dx: float, t_end: float, momentum: str = "balanced") -> str:
     lines = [
         "# Weir benchmark: steady flow over a crest wall",
         "",
-        "Written by `python benchmarks/weir.py` (see its docstring for the set-up): a flat, "
+        f"Written by `python benchmarks/weir.py --momentum {momentum}` (see its docstring for "
+        "the set-up): a flat, "
         "frictionless channel 5 m wide, a crest wall at 1 m across it, fed with Q; the "
         f"particle spacing {dx:g} m, {t_end:g} s simulated, measured over the second half. "
         "H_u and H_d are the mean levels 3-7 m upstream and downstream of the wall above its "
@@ -161,17 +164,20 @@ def main(argv=None) -> list[dict]:
     parser.add_argument("--spacing", type=float, default=0.25)
     parser.add_argument("--time", type=float, default=30.0)
     parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--momentum", choices=[m.value for m in Momentum],
+                        default=Momentum.BALANCED.value, help="numerics.momentum")
     args = parser.parse_args(argv)
     rows = []
     for kind, q_in, crest2 in CASES:
-        row = run_case(kind, q_in, crest2, args.spacing, args.time)
+        row = run_case(kind, q_in, crest2, args.spacing, args.time, Momentum(args.momentum))
         print(f"{kind:9s} Q={q_in:g} H_d/H_u={row['submergence']:.2f} H_u={row['H_u']:.4f} "
               f"(law {row['H_expected']:.4f}, {100 * row['error_H']:+.1f} %) "
               f"q={row['q_model']:.4f} vs {row['q_law']:.4f} ({100 * row['error_q']:+.1f} %) "
               f"{row['wall_s']:.0f} s", flush=True)
         rows.append(row)
     if args.out is not None:
-        args.out.write_text(table(rows, args.spacing, args.time), encoding="utf-8")
+        args.out.write_text(table(rows, args.spacing, args.time, args.momentum),
+                            encoding="utf-8")
         print(f"wrote {args.out}")
     return rows
 

@@ -1,8 +1,10 @@
 """The golden regression cases: small runs whose numbers are stored in ``tests/golden/``.
 
-Each case returns plain data (lists of floats, ints): depth profiles, step and refinement
-counters, mass, gauge values. ``python tests/golden_cases.py`` regenerates the stored files;
-do that only for a change that is meant to move the numbers, and say why in its commit.
+The cases run with the default numerics (the balanced momentum), and the three analytic ones
+also with the variational momentum. Each case returns plain data (lists of floats, ints):
+depth profiles, step and refinement counters, mass, gauge values.
+``python tests/golden_cases.py`` regenerates the stored files; do that only for a change that
+is meant to move the numbers, and say why in its commit.
 Cases run with 2 numba threads, the CI machine's count.
 """
 
@@ -14,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from floodsph.scenario.numerics import Refinement, TimeStepping
+from floodsph.scenario.numerics import Momentum, Refinement, TimeStepping
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
 THREADS = 2
@@ -66,6 +68,12 @@ CASES = {
     "ritter_20m_local_steps": lambda tmp: _analytic("ritter", 20.0,
                                                     time_stepping=TimeStepping.LOCAL),
     "inflow_open_edges_refined_local": _scenario_run,
+    "ritter_20m_variational": lambda tmp: _analytic("ritter", 20.0,
+                                                    momentum=Momentum.VARIATIONAL),
+    "stoker_20m_variational": lambda tmp: _analytic("stoker", 20.0,
+                                                    momentum=Momentum.VARIATIONAL),
+    "thacker_250m_variational": lambda tmp: _analytic("thacker", 250.0,
+                                                      momentum=Momentum.VARIATIONAL),
 }
 
 

@@ -26,7 +26,8 @@ def particles_with_depth(x, y, d, dx, kappa, u=0.0, v=0.0) -> ParticleSet:
 
 def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, manning=0.0,
              walls=(), closed_sides=SIDES, **numerics):
-    """A FloodModel with water given as a level (float) or a depth function d(x, y).
+    """A FloodModel with water given as a level (float) or a depth function d(x, y), seeded at
+    rest at its level d + b (its ``eta_seed``), as a scenario's ``[[initial_water]]`` seeds it.
 
     ``numerics``: fields of its ``Numerics``; ``time_stepping`` defaults to the global step,
     whose facts (exact momentum, one step per call) these cases assert; a test of local
@@ -34,11 +35,12 @@ def model_on(bed, xlim, ylim, cell, level_or_depth, dx, kappa=Numerics.kappa, ma
     terrain = Terrain.from_function(bed, xlim, ylim, cell, manning=manning)
     x, y = lattice(0.0, terrain.width, 0.0, terrain.height, dx)
     xw, yw = x + terrain.x0, y + terrain.y0
+    b = bed(xw, yw)
     if callable(level_or_depth):
-        d = level_or_depth(xw, yw)
+        d = np.asarray(level_or_depth(xw, yw), dtype=float)
     else:
-        d = np.maximum(level_or_depth - bed(xw, yw), 0.0)
-    p = particles_with_depth(x, y, np.asarray(d, dtype=float), dx, kappa)
+        d = np.maximum(level_or_depth - b, 0.0)
+    p = particles_at(x, y, d, dx, kappa, eta_seed=d + b)
     num = Numerics(particle_spacing_m=dx, kappa=kappa,
                    **{"time_stepping": TimeStepping.GLOBAL, **numerics})
     return set_up_model(terrain, p, num, walls=walls, closed_sides=closed_sides)

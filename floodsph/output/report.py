@@ -22,6 +22,8 @@ import math
 from datetime import datetime
 from pathlib import Path
 
+import numpy as np
+
 from floodsph.output.areas import AreaRow, area_by_class, area_by_depth
 
 MAP_PICTURES = (("max_depth.png", "Maximum depth"),
@@ -160,7 +162,10 @@ def _area_section(envelopes) -> str:
     cell = grid.dx * grid.dy
     header = ("colour", "class", "cells", "area [ha]", "share of the flooded area [%]")
     numeric = (2, 3, 4)
-    depth = area_by_depth(maps["max_depth"], cell, envelopes.wet_threshold)
+    # binned as the map files hold it (float32): a depth on a band's edge, as a lake at rest
+    # has, falls in the same band in the table as in max_depth.tif
+    depth = area_by_depth(np.asarray(maps["max_depth"], dtype=np.float32), cell,
+                          envelopes.wet_threshold)
     uk = area_by_class(maps["hazard_uk"], envelopes.tables.uk_names, UK_COLOURS, cell)
     arr = area_by_class(maps["hazard_arr"], envelopes.tables.arr_names, ARR_COLOURS, cell)
     return ("<h2>Flooded area</h2>\n"

@@ -369,7 +369,8 @@ NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are 
     KeyDoc("stabilisation", "string", "Numerical dissipation: a parameter-free Lax-Friedrichs "
            "term, a two-shock Riemann pressure, or the Lax-Friedrichs term on velocities "
            "reconstructed to each pair's midpoint (muscl: sharper bores and fronts, "
-           "docs/reconstruction.md).", choices=Stabilisation),
+           "docs/reconstruction.md). `riemann` and `muscl` need momentum = \"variational\".",
+           choices=Stabilisation),
     KeyDoc("density_tol", "number", "Tolerance of the Newton-Raphson solve for depth and "
            "smoothing length, on |R| / rho."),
     KeyDoc("friction_depth_floor_m", "number", "Depth below which Manning friction is evaluated "
@@ -391,13 +392,14 @@ NUMERICS = TableDoc("numerics", False, "The solver's settings. The defaults are 
     KeyDoc("wall_model", "string", "How walls, closed DEM sides and nodata banks hold water: "
            "`mirror`, mirror images of the particles (default); `integral`, the experimental "
            "boundary integral of the kernel support they hide (docs/still-water.md compares "
-           "the two).", choices=WallModel),
-    KeyDoc("momentum", "string", "The pressure and bed forces: `variational` (default), the "
-           "variational force on the summation depth with the bed pointwise; `balanced`, the "
+           "the two; it needs momentum = \"variational\").", choices=WallModel),
+    KeyDoc("momentum", "string", "The pressure and bed forces: `balanced` (default), the "
            "free-surface level's renormalised differences, which hold a lake at rest exactly "
            "by walls, nodata banks and shores, with the variational force for water faster "
-           "than 0.1 m/s (docs/balanced-momentum.md). Takes stabilisation = "
-           "\"lax-friedrichs\" and wall_model = \"mirror\".", choices=Momentum),
+           "than 0.1 m/s (docs/balanced-momentum.md); `variational`, the variational force on "
+           "the summation depth with the bed pointwise. The `riemann` and `muscl` "
+           "stabilisations and the `integral` wall model need `variational`.",
+           choices=Momentum),
 ))
 
 OUTPUT = TableDoc("output", False, "Where the run folder is and what goes into it.",

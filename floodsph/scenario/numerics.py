@@ -122,10 +122,12 @@ class Numerics:
     step_levels : K of local stepping: a big step holds up to 2^K finest steps.
     wall_model : "mirror" (mirror images, the default) or "integral" (the experimental
         boundary integral of ``floodsph.sph.shadow``).
-    momentum : "variational" (the default) or "balanced": -g grad eta as renormalised
-        differences of the free-surface level eta, a lake at rest an exact equilibrium
-        (``floodsph.sph.level_momentum``); with the "lax-friedrichs" stabilisation and
-        "mirror" walls only.
+    momentum : "balanced" (the default): -g grad eta as renormalised differences of the
+        free-surface level eta, a lake at rest an exact equilibrium
+        (``floodsph.sph.level_momentum``), with the "lax-friedrichs" stabilisation and
+        "mirror" walls only; or "variational": -g grad of the summation depth with the bed
+        pointwise (``floodsph.sph.forces``), which the other stabilisations and wall models
+        need.
 
     Inner tunables (not scenario keys):
 
@@ -157,7 +159,7 @@ class Numerics:
     time_stepping: TimeStepping = _setting(TimeStepping.LOCAL, TimeStepping)
     step_levels: int = _setting(3, int, ge=0, le=6)
     wall_model: WallModel = _setting(WallModel.MIRROR, WallModel)
-    momentum: Momentum = _setting(Momentum.VARIATIONAL, Momentum)
+    momentum: Momentum = _setting(Momentum.BALANCED, Momentum)
     density_max_iter: int = _setting(20, int, ge=1, scenario=False)
     h_ratio: float = _setting(10.0, float, ge=1.0, scenario=False)
     neighbour_skin: float = _setting(0.1, float, ge=0.0, scenario=False)
@@ -180,11 +182,15 @@ class Numerics:
                 f"at once; got {self.refine_area_min:g}")
         if self.momentum is Momentum.BALANCED:
             if self.stabilisation is not Stabilisation.LAX_FRIEDRICHS:
-                raise NumericsError("momentum", "\"balanced\" takes stabilisation = "
-                                    f"\"lax-friedrichs\", got \"{self.stabilisation.value}\"")
+                raise NumericsError(
+                    "stabilisation", f"\"{self.stabilisation.value}\" needs momentum = "
+                    "\"variational\" (the balanced momentum, the default, takes "
+                    "\"lax-friedrichs\" only)")
             if self.wall_model is not WallModel.MIRROR:
-                raise NumericsError("momentum", "\"balanced\" takes wall_model = \"mirror\", "
-                                    f"got \"{self.wall_model.value}\"")
+                raise NumericsError(
+                    "wall_model", f"\"{self.wall_model.value}\" needs momentum = "
+                    "\"variational\" (the balanced momentum, the default, takes \"mirror\" "
+                    "walls only)")
 
 
 def _problem(value, meta) -> str | None:

@@ -9,6 +9,7 @@ import pytest
 from conftest import load_script
 
 from floodsph.boundaries.weir import unit_discharge
+from floodsph.scenario.numerics import Momentum
 
 pytestmark = pytest.mark.benchmark
 
@@ -16,14 +17,20 @@ BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 weir = load_script("weir_benchmark", BENCHMARKS / "weir.py")
 
 
-def test_submerged_weir_passes_what_villemonte_says():
+@pytest.mark.parametrize("momentum", [
+    Momentum.VARIATIONAL,
+    pytest.param(Momentum.BALANCED, marks=pytest.mark.xfail(
+        strict=True, reason="under the balanced momentum the first wall passes 20 % less than "
+        "the submerged law at the levels measured 3-7 m either side (0.111 against 0.139 "
+        "m2/s at 0.25 m spacing); not yet explained"))])
+def test_submerged_weir_passes_what_villemonte_says(momentum):
     """A second, lower crest wall holds a tailwater about half the head above the first
     crest: the net volume passed per metre over the first wall over 10-20 s matches the
     submerged law at the levels measured 3-7 m either side within 15 % (the model passes
     5-10 % less: the particles injected into the tailwater raise its level by the wall, and
     some pieces pass water back), and lies below the free law at the upstream level by about
     Villemonte's factor."""
-    row = weir.run_case("submerged", 0.5, 0.95, 0.25, 20.0)
+    row = weir.run_case("submerged", 0.5, 0.95, 0.25, 20.0, momentum)
     assert 0.3 < row["submergence"] < 0.8
     assert row["q_model"] == pytest.approx(row["q_law"], rel=0.15)
     free = float(unit_discharge(row["H_u"]))

@@ -44,6 +44,7 @@ def test_the_scenarios_values_reach_the_model_under_their_own_names(write_scenar
 
     text = BASE_SCENARIO.replace(
         "cfl = 0.3", 'cfl = 0.25\nfriction_depth_floor_m = 0.05\nstabilisation = "riemann"\n'
+                     'momentum = "variational"\n'
                      "kappa = 1.3\nmax_slope = 0.5\ndensity_tol = 1e-4")
     scenario = load_scenario(write_scenario(text))
     model = build_model(scenario, prepare_inputs(scenario))

@@ -6,7 +6,7 @@ from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.model.builder import set_up_model
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
-from floodsph.scenario.numerics import Numerics
+from floodsph.scenario.numerics import Momentum, Numerics
 
 
 def stretched_lake(stretch, slope, dx=10.0, kappa=Numerics.kappa, patch=None):
@@ -26,7 +26,8 @@ def stretched_lake(stretch, slope, dx=10.0, kappa=Numerics.kappa, patch=None):
     p = ParticleSet(x.size)
     p.append(x=x, y=y, m=RHO_WATER * d * stretch * dx * dx, rho=RHO_WATER * d,
              h=np.full(x.size, kappa * dx * np.sqrt(stretch)))
-    return set_up_model(terrain, p, Numerics(particle_spacing_m=dx, kappa=kappa))
+    return set_up_model(terrain, p, Numerics(particle_spacing_m=dx, kappa=kappa,
+                                             momentum=Momentum.VARIATIONAL))
 
 
 def test_the_pressure_force_on_a_stretched_lattice_is_the_depth_gradient():

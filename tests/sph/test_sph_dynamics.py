@@ -7,7 +7,7 @@ from sph_cases import model_on, particles_with_depth, run_until
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
-from floodsph.scenario.numerics import Numerics, TimeStepping
+from floodsph.scenario.numerics import Momentum, Numerics, TimeStepping
 from floodsph.sph.sums import SUMS
 
 
@@ -26,7 +26,9 @@ def test_closed_box_conserves_mass_and_keeps_every_particle_inside():
 
 def test_momentum_changes_only_through_external_forces():
     """Free flat frictionless bed, no walls reached: sum m v stays at its initial value (with
-    one global step; local steps conserve it to the order of the step)."""
+    one global step; local steps conserve it to the order of the step). The variational
+    momentum's pair forces are antisymmetric; the balanced momentum's renormalised level
+    differences are not, and conserve momentum only as far as they act (slow water)."""
     terrain = Terrain.from_function(lambda x, y: 0 * x, (0, 2000), (0, 2000), 20.0)
     rng = np.random.default_rng(0)
     x, y = np.meshgrid(np.arange(800, 1200, 8.0), np.arange(850, 1150, 8.0))
@@ -35,7 +37,8 @@ def test_momentum_changes_only_through_external_forces():
     p = particles_with_depth(x, y, d, 8.0, 1.3, u=rng.normal(0, 1, x.size) + 2.0,
                              v=rng.normal(0, 1, x.size) - 1.0)
     model = set_up_model(terrain, p, Numerics(particle_spacing_m=8.0, kappa=1.3,
-                                              time_stepping=TimeStepping.GLOBAL),
+                                              time_stepping=TimeStepping.GLOBAL,
+                                              momentum=Momentum.VARIATIONAL),
                          closed_sides=())
     mom0 = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     scale = (p.m * np.hypot(p.u, p.v)).sum()
@@ -148,7 +151,8 @@ def test_the_closer_a_particle_is_to_a_wall_the_harder_the_wall_pushes_it_back()
     (5 m off it) is moved closer. Its acceleration away from the wall grows as the gap shrinks
     (with the plain cubic gradient on its image it peaked at 2 m, 0.33 m s-2, and fell to
     0.03 m s-2 at 0.1 m: particles reaching a wall stuck to it)."""
-    model = model_on(lambda x, y: 0 * x, (0, 200), (0, 100), 10.0, 3.0, 10.0)
+    model = model_on(lambda x, y: 0 * x, (0, 200), (0, 100), 10.0, 3.0, 10.0,
+                     momentum=Momentum.VARIATIONAL)
     p = model.particles
     pid = p.pid[np.flatnonzero(np.isclose(p.x, 105.0) & np.isclose(p.y, 5.0))[0]]
     push = []
@@ -173,7 +177,7 @@ def test_a_dam_break_between_side_walls_stays_uniform_across_the_channel():
     p = model.particles
     for x in (1200.0, 1400.0, 1600.0):
         d = interpolate(np.full(3, x), np.array([2.5, 50.0, 97.5]), p.x, p.y, p.u, p.v, p.m,
-                        p.rho, p.h)[0]
+                        p.rho, p.h, level=model.surface_levels(), bed=np.zeros(3))[0]
         assert np.all(np.abs(d[[0, 2]] / d[1] - 1.0) < 0.03)
 
 
@@ -206,12 +210,10 @@ def test_lake_at_rest_over_a_bump_stays_at_rest():
     assert np.abs(level - 10.0).max() < 0.01 * 10.0
 
 
-@pytest.mark.xfail(strict=True, reason="issue 2: with the shore balance the level holds to 1 % and "
-                   "the shore in place, but where the lattice meets the round shore in steps "
-                   "the shore rows are not at rest: after 200 s 2.2 cm/s (95th percentile), "
-                   "7.7 cm/s at the shore (3.7 cm/s at kappa 1.3; 0.97 m/s without the "
-                   "balance), and the shore's motion grows on longer runs")
 def test_lake_at_rest_in_a_parabolic_bowl_stays_at_rest():
+    """Under the balanced momentum. (The variational force with its shore balance held the
+    level to 1 % and the shore in place, but not the shore rows where the lattice meets the
+    round shore in steps: after 200 s 2.2 cm/s (95th percentile), 7.7 cm/s at the shore.)"""
     bowl = lambda x, y: 10.0 * ((x - 500) ** 2 + (y - 500) ** 2) / 500.0**2  # noqa: E731
     model = model_on(bowl, (0, 1000), (0, 1000), 10.0, 5.0, 10.0)
     run_until(model, 200.0)

@@ -1,5 +1,7 @@
-"""Seeds next to oblique walls: settled and matched to the seeded depth at set-up
-(``floodsph.walls.seeding``), so that still water along such walls stays still."""
+"""Seeds next to oblique walls under the variational momentum: settled and matched to the
+seeded depth at set-up (``floodsph.walls.seeding``), so that still water along such walls
+stays nearly still. The balanced momentum, the default, needs no settling: still water along
+any wall is exact there (``tests/sph/test_balanced_momentum.py``)."""
 
 import math
 
@@ -10,10 +12,12 @@ from sph_cases import lattice, model_on, run_until
 
 from floodsph.constants import RHO_WATER
 from floodsph.model import wall_seeds
-from floodsph.scenario.numerics import Numerics, TimeStepping
+from floodsph.scenario.numerics import Momentum, Numerics, TimeStepping
 from floodsph.walls import seeding as wall_seeding
 from floodsph.walls.geometry import segments_from_polylines
 from floodsph.walls.index import WallIndex
+
+VARIATIONAL = Momentum.VARIATIONAL
 
 
 def turned_rectangle_lake():
@@ -30,7 +34,7 @@ def turned_rectangle_lake():
         return np.where(inside.contains_points(np.column_stack([x, y])), 2.0, 0.0)
 
     return model_on(lambda x, y: np.zeros_like(x), (0.0, 400.0), (0.0, 400.0), 5.0, depth,
-                    5.0, walls=[wall], time_stepping=TimeStepping.LOCAL)
+                    5.0, walls=[wall], time_stepping=TimeStepping.LOCAL, momentum=VARIATIONAL)
 
 
 @pytest.fixture(scope="module")
@@ -83,7 +87,7 @@ def test_walls_along_the_lattice_change_nothing():
     building = np.array([[300.0, 200.0], [500.0, 200.0], [500.0, 400.0], [300.0, 400.0],
                          [300.0, 200.0]])
     model = model_on(lambda x, y: 0 * x, (0, 800), (0, 600), 10.0, depth, 10.0,
-                     walls=[building])
+                     walls=[building], momentum=VARIATIONAL)
     x, y = lattice(0.0, 800.0, 0.0, 600.0, 10.0)
     keep = depth(x, y) > 0
     p = model.particles
@@ -100,7 +104,7 @@ def test_seeds_that_need_no_settling_leave_the_set_up_as_it_was(monkeypatch):
     ``test_sph_dynamics.py``'s side-wall test past its 3 % bound (3.1 %)."""
     def build():
         return model_on(lambda x, y: 0 * x, (0, 2000), (0, 100), 10.0,
-                        lambda x, y: np.where(x < 1000, 10.0, 0.0), 10.0)
+                        lambda x, y: np.where(x < 1000, 10.0, 0.0), 10.0, momentum=VARIATIONAL)
 
     model = build()
     assert model.counters["seeds_settled"] > 500 and model.counters["settle_steps"] == 0
