@@ -22,7 +22,7 @@ weir = load_script("weir_benchmark", BENCHMARKS / "weir.py")
     pytest.param(Momentum.BALANCED, marks=pytest.mark.xfail(
         strict=True, reason="under the balanced momentum the first wall passes 20 % less than "
         "the submerged law at the levels measured 3-7 m either side (0.111 against 0.139 "
-        "m2/s at 0.25 m spacing); not yet explained"))])
+        "m2/s at 0.25 m spacing): its pieces pass 1.6 times as much water back"))])
 def test_submerged_weir_passes_what_villemonte_says(momentum):
     """A second, lower crest wall holds a tailwater about half the head above the first
     crest: the net volume passed per metre over the first wall over 10-20 s matches the
