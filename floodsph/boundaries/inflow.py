@@ -29,6 +29,7 @@ import math
 import numpy as np
 
 from floodsph.boundaries.riemann import critical_depth, inflow_state
+from floodsph.boundaries.section import section_coordinates, section_opening
 from floodsph.checks.inflows import inward_normal
 from floodsph.constants import GRAVITY, RHO_WATER
 
@@ -113,14 +114,11 @@ class Inflow:
     @property
     def opening(self) -> np.ndarray:
         """The section as a (2, 2) array [A, B] (walls along it are cut open)."""
-        return np.stack([self.a, self.a + self.length * self.tangent])
+        return section_opening(self.a, self.tangent, self.length)
 
     def _coordinates(self, x, y):
         """(s, tau): distance along the inward normal and along the line from A [m]."""
-        rx = x - self.a[0]
-        ry = y - self.a[1]
-        s = rx * self.normal[0] + ry * self.normal[1]
-        return s, rx * self.tangent[0] + ry * self.tangent[1]
+        return section_coordinates(self.a, self.normal, self.tangent, x, y)
 
     def _row(self, s: float):
         """Positions (x, y) of one row of N particles at normal offset s."""

@@ -36,6 +36,7 @@ import numpy as np
 
 from floodsph.boundaries.inflow import DEPTH_MIN_M, lattice_alpha_ratio
 from floodsph.boundaries.riemann import level_state
+from floodsph.boundaries.section import section_coordinates, section_opening
 from floodsph.boundaries.weir import bed_at
 from floodsph.constants import GRAVITY, RHO_WATER
 
@@ -100,14 +101,11 @@ class LevelBoundary:
     @property
     def opening(self) -> np.ndarray:
         """The section as a (2, 2) array [A, B] (walls along it are cut open)."""
-        return np.stack([self.a, self.a + self.length * self.tangent])
+        return section_opening(self.a, self.tangent, self.length)
 
     def _coordinates(self, x, y):
         """(s, tau): distance along the inward normal and along the line from A [m]."""
-        rx = x - self.a[0]
-        ry = y - self.a[1]
-        return (rx * self.normal[0] + ry * self.normal[1],
-                rx * self.tangent[0] + ry * self.tangent[1])
+        return section_coordinates(self.a, self.normal, self.tangent, x, y)
 
     def _points(self, columns, s):
         """Positions (x, y) of the points of ``columns`` at normal offsets ``s`` [m]."""
