@@ -10,9 +10,9 @@ stage timer (``floodsph.model.stage_timer``) adding up the wall time of each sta
 size: particle-steps/s, ms per step and the stages' share in us per step, medians over
 ``--repeats``; and a least-squares fit of the time per step, t = fixed + per_particle n, over
 the sizes: ``fixed`` is the cost of a step that does not grow with the particles.
-``--momentum balanced`` measures the balanced momentum (``numerics.momentum``) instead of the
-variational one. Each row also gives the neighbour-list builds per step (the model's
-``neighbour_builds`` counter, where the checkout has it).
+``--momentum balanced`` or ``variational`` measures that momentum (``numerics.momentum``);
+without it, each checkout's default. Each row also gives the neighbour-list builds per step
+(the model's ``neighbour_builds`` counter, where the checkout has it).
 
 ``--compare REF`` runs the same measurements on a second checkout in the same invocation,
 each checkout in its own worker process, alternating one measurement of each (so that both
@@ -76,11 +76,11 @@ def piece(name: str):
     raise ImportError(f"step_cost: this floodsph has no {name}")
 
 
-def dam_break(spacing: float, momentum: str = "variational"):
+def dam_break(spacing: float, momentum: str | None = None):
     """The FloodModel of the dam break at ``spacing`` [m] (module docstring) under the
-    ``momentum`` named (``numerics.momentum``), built from the public pieces only
-    (``Terrain``, ``ParticleSet``, ``Numerics``, the model's set-up), so that any checkout
-    builds the same case."""
+    ``momentum`` named (``numerics.momentum``; None: the checkout's default), built from the
+    public pieces only (``Terrain``, ``ParticleSet``, ``Numerics``, the model's set-up), so
+    that any checkout builds the same case."""
     from floodsph.constants import RHO_WATER
 
     set_up_model, ParticleSet, Terrain, Numerics = (
@@ -92,7 +92,7 @@ def dam_break(spacing: float, momentum: str = "variational"):
     x, y = (a.ravel() for a in np.meshgrid(x1, y1))
     p = ParticleSet(x.size)
     # one global step, so that a step is one update of every particle in every checkout
-    chosen = {} if momentum == "variational" else {"momentum": piece("Momentum")(momentum)}
+    chosen = {} if momentum is None else {"momentum": piece("Momentum")(momentum)}
     numerics = Numerics(particle_spacing_m=spacing,
                         time_stepping=piece("TimeStepping").GLOBAL, **chosen)
     p.append(x=x, y=y, m=np.full(x.size, RHO_WATER * DEPTH_M * spacing * spacing),
@@ -101,7 +101,7 @@ def dam_break(spacing: float, momentum: str = "variational"):
     return set_up_model(terrain, p, numerics)
 
 
-def measure(spacing: float, steps: int, warmup: int, momentum: str = "variational") -> dict:
+def measure(spacing: float, steps: int, warmup: int, momentum: str | None = None) -> dict:
     """One measurement of the dam break at ``spacing`` under ``momentum``: ``particles``,
     ``steps``, ``particle_steps_per_s`` and ``ms_per_step`` of the timed steps,
     ``list_builds_per_step`` and each stage's ``us_<stage>`` per step when the checkout has
@@ -217,7 +217,7 @@ def fixed_cost(rows: list[dict]) -> tuple[float, float]:
 
 
 def run(checkouts, sizes, steps: int, warmup: int, repeats: int,
-        momentum: str = "variational") -> list[dict]:
+        momentum: str | None = None) -> list[dict]:
     """Median measurement per checkout and size, the checkouts alternating (in turned order
     from one repeat to the next)."""
     samples = {(c.name, size): [] for c in checkouts for size in sizes}
@@ -282,8 +282,8 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=1, help="numba threads (0 = all cores)")
     ap.add_argument("--sizes", type=int, nargs="+", default=sorted(SIZES),
                     choices=sorted(SIZES), help="nominal particle counts")
-    ap.add_argument("--momentum", choices=("variational", "balanced"), default="variational",
-                    help="numerics.momentum of the dam break")
+    ap.add_argument("--momentum", choices=("variational", "balanced"), default=None,
+                    help="numerics.momentum of the dam break (default: each checkout's)")
     ap.add_argument("--compare", metavar="REF", help="a second checkout: path or commit")
     ap.add_argument("--ref-dir", type=Path,
                     default=Path(tempfile.gettempdir()) / "floodsph-step-cost",
