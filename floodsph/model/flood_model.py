@@ -253,8 +253,7 @@ class FloodModel:
             level_offsets.hold_still(p.u, p.v, p.x, p.y, p.x_seed, p.y_seed, p.bank_held, dt,
                                      level_momentum.HOLD_TIME, level_momentum.HOLD_STIFFNESS)
         moves = None if self.flux_lines is None else (p.x.copy(), p.y.copy())
-        self.counters["wall_reflections"] += int(sight.drift(
-            p.x, p.y, p.u, p.v, dt, self.walls_near.wstart, self.walls_near.wseg, self.seg))
+        self.counters["wall_reflections"] += self.wall_index.drift(p.x, p.y, p.u, p.v, dt)
         if moves is not None:
             self.count_moves(*moves, p.x, p.y, p.m)
         self._nl_here = False
@@ -377,8 +376,8 @@ class FloodModel:
         The lists are built for h_i times the growth of h_i in the last density solve
         (``hgrow``, at most ``MAX_SEARCH_GROWTH``), so that a particle whose h keeps growing
         in the solves (a thinning edge) is not held back by its lists step after step
-        (:meth:`_solve_density`). ``rows``: list only these particles' neighbours (the
-        near-wall lists still cover every particle, for the drift).
+        (:meth:`_solve_density`). ``rows``: list only these particles' neighbours and near
+        walls (the drift finds its walls in the wall index).
         """
         p = self.particles
         nl = self.nl
@@ -392,7 +391,7 @@ class FloodModel:
         self.nl = NeighbourList(p.x, p.y, h_search, skin=self.numerics.neighbour_skin,
                                 rows=rows)
         self.walls_near = self.wall_index.near_lists(p.x, p.y, h_search, self.nl.start,
-                                                     self.nl.nbr, self.nl.reach)
+                                                     self.nl.nbr, self.nl.reach, rows)
         self._lap("neighbours")
 
     def block_pairs(self) -> None:

@@ -13,7 +13,6 @@ from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.model.flood_model import FloodModel
 from floodsph.sph.bed import BED
 from floodsph.walls import seeding as wall_seeding
-from floodsph.walls import sight
 
 
 def settle_at_walls(model: FloodModel, rho_seed: np.ndarray) -> float:
@@ -80,8 +79,7 @@ def _settle(model: FloodModel, idx: np.ndarray, rows: np.ndarray) -> int:
            and np.hypot(p.ax[idx], p.ay[idx]).max() >= wall_seeding.SETTLED * GRAVITY):
         mx[idx], my[idx] = wall_seeding.limited_move(p.ax[idx], p.ay[idx], model.stable_dt(),
                                                      p.x[idx] - x0, p.y[idx] - y0, limit)
-        near = model.walls_near
-        sight.drift(p.x, p.y, mx, my, 1.0, near.wstart, near.wseg, model.seg)
+        model.wall_index.drift(p.x, p.y, mx, my, 1.0)
         model.interactions(settle=True, rows=rows)
         taken += 1
     model.counters["settle_steps"] = taken

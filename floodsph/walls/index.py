@@ -18,10 +18,15 @@ from numba import njit, prange
 from scipy import ndimage
 
 from floodsph.walls.geometry import segment_distance
+from floodsph.walls.sight import drift
 
 NEAR_BUCKETS = 2.0
 """Radius, in level-0 buckets, up to which a particle's near segments are found among its own
 bucket's precomputed candidates (:func:`_near_scan`); larger radii walk the bucket pyramid."""
+DRIFT_BUCKET = 0.25
+"""Side of the buckets of the drift's finest candidate table, in level-0 buckets (half the
+seeded smoothing length h0 when a level-0 bucket is 2 h0): a move shorter than that side
+tests only the segments within it of its bucket (``floodsph.walls.sight.drift``)."""
 
 
 class MapWalls(NamedTuple):
@@ -45,6 +50,22 @@ class NearWalls(NamedTuple):
     wseg: np.ndarray
     cstart: np.ndarray
     cpair: np.ndarray
+
+
+class DriftTable(NamedTuple):
+    """Candidate segments of a drift (``floodsph.walls.sight.drift``): a grid of ``nbx`` x
+    ``nby`` square buckets of side ``bucket`` [m] from (``xmin``, ``ymin``), bucket b listing
+    ``items[start[b]:start[b + 1]]`` (in increasing index): every segment whose bounding box
+    widened by ``radius`` [m] overlaps it."""
+
+    start: np.ndarray
+    items: np.ndarray
+    xmin: float
+    ymin: float
+    bucket: float
+    nbx: int
+    nby: int
+    radius: float
 
 
 class WallLists(NamedTuple):
@@ -122,13 +143,36 @@ class WallIndex:
         self.near_start = np.zeros(nbx * nby + 1, dtype=np.int64)
         np.cumsum(near_counts, out=self.near_start[1:])
         self.pstart, self.partner = _corner_partners(self.seg)
+        fine = DRIFT_BUCKET * sizes[0]
+        fine_nbx = max(1, int((xmax - xmin) / fine) + 1)
+        fine_nby = max(1, int((ymax - ymin) / fine) + 1)
+        fine_counts, fine_items = _bucket_lists(
+            np.hstack([np.minimum(self.seg[:, :2], self.seg[:, 2:]) - fine,
+                       np.maximum(self.seg[:, :2], self.seg[:, 2:]) + fine]),
+            self.xmin, self.ymin, fine, fine_nbx, fine_nby)
+        fine_start = np.zeros(fine_nbx * fine_nby + 1, dtype=np.int64)
+        np.cumsum(fine_counts, out=fine_start[1:])
+        self.drift_tables = (
+            DriftTable(fine_start, fine_items, self.xmin, self.ymin, fine, fine_nbx, fine_nby,
+                       fine),
+            DriftTable(self.near_start, self.near_items, self.xmin, self.ymin, sizes[0], nbx,
+                       nby, self.near_radius))
+        self.every = np.arange(self.seg.shape[0], dtype=np.int64)
         self.width = 16  # row width of the near-segment scan, widened when a row overflows
 
-    def near_lists(self, x, y, h, nstart, nbr, reach):
+    def drift(self, x, y, u, v, dt: float) -> int:
+        """Drift x <- x + dt v [m], reflecting the moves that would cross a segment
+        (``floodsph.walls.sight.drift``, with this index's :class:`DriftTable` s: the fine
+        buckets', then the level-0 buckets' candidates); returns the number of reflections."""
+        return int(drift(x, y, u, v, dt, self.seg, *self.drift_tables, self.every))
+
+    def near_lists(self, x, y, h, nstart, nbr, reach, rows=None):
         """The :class:`NearWalls` lists of the segments within each particle's reach, and of its
         wall corners. The radius of particle i is reach * max(h_i, max_j h_j) over its
         neighbours j, so a wall between i and any neighbour is always in i's list (pair
-        blocking is symmetric).
+        blocking is symmetric). ``rows``: list only these particles' segments (the others'
+        lists are empty), as local time stepping needs them for the particles it updates
+        alone; default every particle.
         """
         n = x.shape[0]
         wstart = np.zeros(n + 1, dtype=np.int64)
@@ -136,20 +180,22 @@ class WallIndex:
         if self.seg.shape[0] == 0 or n == 0:
             return NearWalls(wstart, np.zeros(0, dtype=np.int64), cstart,
                              np.zeros((0, 2), dtype=np.int64))
-        args = (x, y, h, nstart, nbr, reach, self.seg, self.start, self.items, self.clear,
-                self.near_radius, self.near_start, self.near_items, self.xmin, self.ymin,
-                self.lv_bucket, self.lv_nbx, self.lv_nby, self.lv_off, float(h.max()))
-        count = np.empty(n, dtype=np.int64)
+        listed = np.arange(n, dtype=np.int64) if rows is None else rows
+        args = (listed, x, y, h, nstart, nbr, reach, self.seg, self.start, self.items,
+                self.clear, self.near_radius, self.near_start, self.near_items, self.xmin,
+                self.ymin, self.lv_bucket, self.lv_nbx, self.lv_nby, self.lv_off,
+                float(h.max()))
+        count = np.zeros(n, dtype=np.int64)
         while True:  # one scan into rows of ``width``; again, wider, if a row overflowed
-            rows = np.empty((n, self.width), dtype=np.int64)
-            _near_scan(*args, rows, count)
+            found = np.empty((listed.shape[0], self.width), dtype=np.int64)
+            _near_scan(*args, found, count)
             widest = int(count.max())
             if widest <= self.width:
                 break
             self.width = widest
         np.cumsum(count, out=wstart[1:])
         wseg = np.empty(wstart[-1], dtype=np.int64)
-        _gather_rows(rows, wstart, wseg)
+        _gather_rows(listed, found, wstart, wseg)
         corners = (wstart, wseg, self.pstart, self.partner, cstart)
         _corner_scan(*corners, np.zeros((0, 2), dtype=np.int64), False)
         np.cumsum(cstart, out=cstart)
@@ -210,19 +256,23 @@ def first_visit(seg, s, bx, by, qbx0, qby0, xmin, ymin, bucket, nbx, nby):
 
 
 @njit(parallel=True, cache=True)
-def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, near_radius, near_start,
-               near_items, xmin, ymin, lv_bucket, lv_nbx, lv_nby, lv_off, h_top, rows, count):
-    """Count (into ``count[i]``) and list (into ``rows[i]``, in index order, as far as the row
-    is wide) each particle's segments within reach * max(h_i, max_j h_j); a particle inside
+def _near_scan(listed, x, y, h, nstart, nbr, reach, seg, bstart, items, clear, near_radius,
+               near_start, near_items, xmin, ymin, lv_bucket, lv_nbx, lv_nby, lv_off, h_top,
+               found, count):
+    """Count (into ``count[i]``) and list (into ``found[r]``, in index order, as far as the row
+    is wide) the segments of each particle ``i = listed[r]`` within reach * max(h_i, max_j
+    h_j); a particle inside
     the level-0 grid whose radius is below its bucket's ``clear`` distance has none (tested
     first with the largest h of all, ``h_top``, before its neighbours are walked). One whose
     radius is at most ``near_radius`` tests its level-0 bucket's candidates
     (``near_items[near_start[b]:near_start[b + 1]]``, every segment within ``near_radius`` of
     the bucket, in index order); the others walk the buckets of the finest level at least
     half as wide as the radius."""
-    width = rows.shape[1]
+    width = found.shape[1]
     top = lv_bucket.shape[0] - 1
-    for i in prange(x.shape[0]):
+    for r in prange(listed.shape[0]):
+        i = listed[r]
+        row = found[r]
         count[i] = 0
         cx = (x[i] - xmin) / lv_bucket[0]
         cy = (y[i] - ymin) / lv_bucket[0]
@@ -239,7 +289,7 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, near_radi
         if inside and radius <= near_radius:
             k = 0
             for q in range(near_start[b0], near_start[b0 + 1]):
-                k = _take_if_near(x[i], y[i], seg, near_items[q], radius, rows[i], k)
+                k = _take_if_near(x[i], y[i], seg, near_items[q], radius, row, k)
             count[i] = k
             continue
         lv = 0
@@ -257,10 +307,10 @@ def _near_scan(x, y, h, nstart, nbr, reach, seg, bstart, items, clear, near_radi
                 for q in range(bstart[b], bstart[b + 1]):
                     s = items[q]
                     if first_visit(seg, s, bx, by, bx0, by0, xmin, ymin, bucket, nbx, nby):
-                        k = _take_if_near(x[i], y[i], seg, s, radius, rows[i], k)
+                        k = _take_if_near(x[i], y[i], seg, s, radius, row, k)
         count[i] = k
         if k <= width:
-            _sort_run(rows[i], 0, k)
+            _sort_run(row, 0, k)
 
 
 @njit(inline="always", cache=True)
@@ -275,11 +325,13 @@ def _take_if_near(px, py, seg, s, radius, row, k):
 
 
 @njit(parallel=True, cache=True)
-def _gather_rows(rows, wstart, wseg):
-    """Copy the first wstart[i + 1] - wstart[i] entries of each row into the CSR ``wseg``."""
-    for i in prange(rows.shape[0]):
+def _gather_rows(listed, found, wstart, wseg):
+    """Copy the first wstart[i + 1] - wstart[i] entries of row r of ``found`` into the CSR
+    ``wseg``, for each particle ``i = listed[r]``."""
+    for r in prange(listed.shape[0]):
+        i = listed[r]
         for k in range(wstart[i + 1] - wstart[i]):
-            wseg[wstart[i] + k] = rows[i, k]
+            wseg[wstart[i] + k] = found[r, k]
 
 
 @njit(inline="always", cache=True)

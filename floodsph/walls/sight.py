@@ -40,6 +40,10 @@ def hides(ax, ay, bx, by, seg, s):
                    seg[s, 3])
 
 
+NEAR_SHARE = 0.9
+"""Share of a bucket's candidate radius up to which :func:`drift` tests the bucket's
+candidates alone (the margin covers the rounding of the widened boxes)."""
+
 SIGHT_SLACK = 1e-2
 """Slack [m] of the distance tests that skip far segments: a segment that :func:`hides` a
 point at distance r from particle i lies within r + |TIE_SHIFT| (1 mm) of i, so one
@@ -84,28 +88,69 @@ def blocked_pairs(rows, x, y, nstart, nbr, wstart, wseg, seg, out, wdist):
             out[q] = hit
 
 
+@njit(inline="always", cache=True)
+def _first_crossing(x0, y0, x1, y1, seg, candidates, lo, hi):
+    """The first segment of ``candidates[lo:hi]`` that the move (x0, y0) -> (x1, y1) crosses,
+    or -1."""
+    for q in range(lo, hi):
+        s = candidates[q]
+        if crosses(x0, y0, x1, y1, seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]):
+            return s
+    return -1
+
+
+@njit(inline="always", cache=True)
+def _bucket_of(px, py, xmin, ymin, bucket, nbx, nby):
+    """Flat index of the bucket of side ``bucket`` [m] holding (px, py) on a grid of nbx x nby
+    buckets from (xmin, ymin), or -1 outside it."""
+    cx = (px - xmin) / bucket
+    cy = (py - ymin) / bucket
+    if 0.0 <= cx < nbx and 0.0 <= cy < nby:
+        return int(cy) * nbx + int(cx)
+    return -1
+
+
 @njit(parallel=True, cache=True)
-def drift(x, y, u, v, dt, wstart, wseg, seg):
+def drift(x, y, u, v, dt, seg, fine, near, every):
     """Drift x <- x + dt v, reflecting moves that cross a wall. Returns the reflection count.
 
-    A move x_old -> x that meets a segment of the particle's near-wall list is mirrored about
-    the segment's line and the velocity's normal component reversed; after three reflections
-    (a corner) the particle is put back to x_old with zero velocity.
+    A move x_old -> x that crosses a segment is mirrored about the segment's line and the
+    velocity's normal component reversed; after three reflections (a corner) the particle is
+    put back to x_old with zero velocity. The segments tested, in increasing index, are the
+    candidates of x_old's bucket in the ``fine`` candidate table of
+    ``floodsph.walls.index.WallIndex`` (a ``DriftTable``: buckets of side ``bucket`` [m],
+    each listing every segment whose box widened by ``radius`` [m] overlaps it) if the move's
+    length L is below ``NEAR_SHARE`` times its radius, else in the ``near`` table on the same
+    terms: each point of the move, and of its reflections, lies within L of x_old, so they
+    hold every segment the move can cross. A longer move, or one from outside the buckets,
+    tests ``every`` segment.
     """
+    f_start, f_items, xmin, ymin, f_bucket, f_nbx, f_nby, f_radius = fine
+    n_start, n_items, _, _, n_bucket, n_nbx, n_nby, n_radius = near
     total = 0
     for i in prange(x.shape[0]):
         x_old = x[i]
         y_old = y[i]
         x[i] = x_old + dt * u[i]
         y[i] = y_old + dt * v[i]
+        travel = math.hypot(x[i] - x_old, y[i] - y_old)
+        candidates = every
+        lo = 0
+        hi = every.shape[0]
+        b = _bucket_of(x_old, y_old, xmin, ymin, f_bucket, f_nbx, f_nby)
+        if b >= 0 and travel < NEAR_SHARE * f_radius:
+            candidates = f_items
+            lo = f_start[b]
+            hi = f_start[b + 1]
+        else:
+            b = _bucket_of(x_old, y_old, xmin, ymin, n_bucket, n_nbx, n_nby)
+            if b >= 0 and travel < NEAR_SHARE * n_radius:
+                candidates = n_items
+                lo = n_start[b]
+                hi = n_start[b + 1]
         hits = 0
         for _ in range(3):
-            hit = -1
-            for k in range(wstart[i], wstart[i + 1]):
-                s = wseg[k]
-                if crosses(x_old, y_old, x[i], y[i], seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]):
-                    hit = s
-                    break
+            hit = _first_crossing(x_old, y_old, x[i], y[i], seg, candidates, lo, hi)
             if hit < 0:
                 break
             hits += 1
