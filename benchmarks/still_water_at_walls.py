@@ -86,7 +86,8 @@ def still_water_row(case: str, times) -> str:
     setup = time.perf_counter() - t0
     p = model.particles
     cells = [case, f"{np.abs(model.depth() - depth).max():.3f}",
-             f"{model.counters['seeds_settled']}", f"{model.volume_seed_adjustment:+.1f}",
+             f"{model.state.counters['seeds_settled']}",
+             f"{model.state.volume_seed_adjustment:+.1f}",
              f"{setup:.1f}"]
     t0 = time.perf_counter()
     for _ in range(10):
