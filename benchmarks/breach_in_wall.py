@@ -160,14 +160,14 @@ class Probe:
         right = (bx - ax) * (p.y - ay) - (by - ay) * (p.x - ax) < 0.0
         volume = p.m / RHO_WATER
         depth = model.depth()
-        level = depth + model.bed[: p.n, 0]
+        level = depth + model.state.bed[: p.n, 0]
         xc, yc = self.centre
         near = (np.abs(p.y - yc) < 0.5 * self.BOX) & (depth > 0.01)
         up = near & (p.x < xc) & (p.x > xc - self.BOX)
         down = near & (p.x > xc) & (p.x < xc + self.BOX)
         values = (float(model.t), float(np.sum(volume[right])),
                   float(lines.forward[self.line] - lines.backward[self.line]),
-                  float(model.volume_out), float(np.sum(volume[p.x < self.wall_x])),
+                  float(model.state.volume_out), float(np.sum(volume[p.x < self.wall_x])),
                   float(np.mean(level[up])) if up.any() else math.nan,
                   float(np.mean(level[down])) if down.any() else math.nan)
         self.rows.append(dict(zip(self.COLUMNS, values, strict=True)))
@@ -297,7 +297,7 @@ def still_lake(scenario, seconds: float, root: Path) -> list[dict]:
         def last(sim, final=final) -> None:
             model = sim.model
             p = model.particles
-            level = model.depth() + model.bed[: p.n, 0]
+            level = model.depth() + model.state.bed[: p.n, 0]
             final.update(speed=float(np.max(np.hypot(p.u, p.v))),
                          stray=float(np.max(np.abs(level - level0))))
 

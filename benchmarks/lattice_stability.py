@@ -150,7 +150,7 @@ def bowl_lake(end_time: float, every: float = 100.0, spacing: float = 10.0,
         while model.t < t_end - 1e-9:
             model.step(t_end - model.t)
         speed = np.hypot(p.u[:p.n], p.v[:p.n])
-        off = np.abs(model.depth() + model.bed[:p.n, 0] - level).max()
+        off = np.abs(model.depth() + model.state.bed[:p.n, 0] - level).max()
         out.append((float(t_end), float(speed.max()), float(np.percentile(speed, 95)),
                     float(off)))
     return out

@@ -44,7 +44,7 @@ def profile(model, steps: int | None = None, end_time: float | None = None,
         model.step()
     timer = StageTimer()
     model.stage_timer = timer
-    step0, builds0, particle_steps = model.steps, model.counters["neighbour_builds"], 0
+    step0, builds0, particle_steps = model.steps, model.state.counters["neighbour_builds"], 0
     t0 = time.perf_counter()
     try:
         while (steps is None or model.steps - step0 < steps) and (
@@ -61,7 +61,7 @@ def profile(model, steps: int | None = None, end_time: float | None = None,
             for k, v in times.most_common()]
     totals = {"wall_s": wall, "steps": nsteps, "sim_time_s": model.t,
               "particle_steps": particle_steps,
-              "list_builds_per_step": (model.counters["neighbour_builds"] - builds0)
+              "list_builds_per_step": (model.state.counters["neighbour_builds"] - builds0)
               / max(nsteps, 1)}
     return rows, totals
 

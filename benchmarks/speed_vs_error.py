@@ -101,19 +101,19 @@ def throughput(kind: str, n_side: int = BLOCK_SIDE, steps: int = 10, repeats: in
     for _ in range(repeats):
         wall, pst, pairs, builds = 0.0, 0, 0, 0
         for _ in range(steps):
-            p, nl = model.particles, model.nl
+            p, nl = model.particles, model.work.nl
             pst += p.n
             pairs += nl.interactions(p.x, p.y, p.h)
             t0 = time.perf_counter()
             model.step()
             wall += time.perf_counter() - t0
-            builds += model.nl is not nl
+            builds += model.work.nl is not nl
         if best is None or pst / wall > best[1] / best[0]:
             best = (wall, pst, pairs, builds)
     wall, pst, pairs, builds = best
     row = cases.CaseResult(f"throughput-{kind}", 5.0, model.particles.n, steps, wall, pst,
                            pairs, math.nan, math.nan, 0.0,
-                           particles_max=model.counters["particles_max"])
+                           particles_max=model.state.counters["particles_max"])
     return row, builds / steps
 
 

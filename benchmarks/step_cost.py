@@ -112,17 +112,18 @@ def measure(spacing: float, steps: int, warmup: int, momentum: str | None = None
     timer = None
     if hasattr(model, "stage_timer"):  # else a checkout from before the stage timer
         timer = model.stage_timer = piece("StageTimer")()
-    updates = model.counters["particle_updates"]
-    builds = model.counters.get("neighbour_builds")
+    counters = getattr(model, "state", model).counters  # a checkout before the State: the model's
+    updates = counters["particle_updates"]
+    builds = counters.get("neighbour_builds")
     t0 = time.perf_counter()
     for _ in range(steps):
         model.step()
     wall = time.perf_counter() - t0
     row = {"particles": model.particles.n, "steps": steps,
-           "particle_steps_per_s": (model.counters["particle_updates"] - updates) / wall,
+           "particle_steps_per_s": (counters["particle_updates"] - updates) / wall,
            "ms_per_step": 1e3 * wall / steps}
     if builds is not None:
-        row["list_builds_per_step"] = (model.counters["neighbour_builds"] - builds) / steps
+        row["list_builds_per_step"] = (counters["neighbour_builds"] - builds) / steps
     if timer is not None:
         row |= {f"us_{stage}": 1e6 * s / steps for stage, s in timer.seconds.items()}
     return row

@@ -123,7 +123,7 @@ class Probe:
         if eta is not None:  # the balanced momentum: maps report the level less the bed
             self.particles["level"] = eta.copy()
         else:  # the variational momentum: the summed depth on the bed
-            eta = model.depth() + model.bed[: p.n, 0]
+            eta = model.depth() + model.state.bed[: p.n, 0]
         level = (np.abs(eta - case.level_m) if case.level_m is not None and p.n
                  else np.array([math.nan]))
         x, y = terrain.to_world(p.x, p.y)

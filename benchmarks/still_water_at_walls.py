@@ -1,7 +1,7 @@
 """Still water next to walls that do not run along the seeding lattice, with and without the
 set-up of ``floodsph.walls.seeding`` (seeds settled, masses matched to the seeded depth).
 
-Cases (flat, frictionless beds; walls as ``FloodModel(walls=...)`` polylines):
+Cases (flat, frictionless beds; walls as ``set_up_model(walls=...)`` polylines):
 
 * ``turned-rectangle``: 2 m of water inside a 300 m x 180 m rectangle of walls turned by
   30 degrees, 5 m spacing (the lake of ``tests/walls/test_wall_seeding.py``);
@@ -86,7 +86,8 @@ def still_water_row(case: str, times) -> str:
     setup = time.perf_counter() - t0
     p = model.particles
     cells = [case, f"{np.abs(model.depth() - depth).max():.3f}",
-             f"{model.counters['seeds_settled']}", f"{model.volume_seed_adjustment:+.1f}",
+             f"{model.state.counters['seeds_settled']}",
+             f"{model.state.volume_seed_adjustment:+.1f}",
              f"{setup:.1f}"]
     t0 = time.perf_counter()
     for _ in range(10):

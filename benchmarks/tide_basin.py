@@ -96,7 +96,7 @@ def run_case(length: float, width: float, spacing: float, periods: float,
             model.step(t - model.t)
         times.append(model.t)
         levels.append(far_level(model, spacing))
-        balance = v0 + model.volume_in - model.volume_out - model.volume()
+        balance = v0 + model.state.volume_in - model.state.volume_out - model.volume()
         imbalance = max(imbalance, abs(balance))
     times_a, levels_a = np.array(times), np.array(levels)
     after = times_a >= period
@@ -109,7 +109,8 @@ def run_case(length: float, width: float, spacing: float, periods: float,
         "error_wave": float(np.abs(levels_a - wave)[after].max()),
         "error_imposed": float(np.abs(levels_a - imposed)[after].max()),
         "amplification": 1.0 / math.cos(omega / math.sqrt(GRAVITY * DEPTH) * length),
-        "volume_initial": v0, "volume_in": model.volume_in, "volume_out": model.volume_out,
+        "volume_initial": v0, "volume_in": model.state.volume_in,
+        "volume_out": model.state.volume_out,
         "volume_final": model.volume(), "imbalance": imbalance,
         "particles": model.particles.n, "steps": model.steps,
         "wall_s": time.perf_counter() - started,

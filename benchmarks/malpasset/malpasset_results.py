@@ -43,7 +43,7 @@ class ParticleCounter:
     def __call__(self, sim) -> None:
         model = sim.model
         self.rows.append((float(model.t), len(model.particles), sim.wall_time,
-                          float(model.volume_out)))
+                          float(model.state.volume_out)))
 
     def write_csv(self, path: Path) -> Path:
         with open(path, "w", newline="") as f:

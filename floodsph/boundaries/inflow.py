@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from floodsph.boundaries.protocol import Site, Water
 from floodsph.boundaries.riemann import critical_depth, inflow_state
 from floodsph.boundaries.section import section_coordinates, section_opening
 from floodsph.checks.inflows import inward_normal
@@ -128,21 +129,21 @@ class Inflow:
         return x, y
 
     # -- the boundary protocol -------------------------------------------------------------
-    def apply(self, model, dt: float) -> None:
+    def apply(self, water: Water, site: Site, dt: float) -> None:
         """Advance the buffer by w_B dt, inject the rows that crossed, update (d_B, w_B)."""
-        t_end = model.t + dt
+        t_end = water.t + dt
         self.t = t_end
-        self._reflect_backflow(model)
+        self._reflect_backflow(water.particles, site)
         self.phase += self.w_b * dt
         while self.phase >= 0.0:
             lead = (0.5 * self.dx_n - self.phase) / self.w_b
-            self._inject_row(model, t_end + lead, self.phase, cap=1.5 * self.d_b)
+            self._inject_row(water, t_end + lead, self.phase, cap=1.5 * self.d_b)
             self.phase -= self.dx_n
-        self._update_state(model, t_end)
+        self._update_state(water.particles, t_end)
         if self.regime == "closed":
-            self._inject_row(model, t_end, 0.5 * self.dx_n, cap=np.inf)
+            self._inject_row(water, t_end, 0.5 * self.dx_n, cap=np.inf)
 
-    def _reflect_backflow(self, model) -> None:
+    def _reflect_backflow(self, p, site: Site) -> None:
         """Mirror water that moved back across the section (s < 0) into the domain.
 
         The hydrograph is the only exchange with what lies behind the section, so the section
@@ -151,7 +152,6 @@ class Inflow:
         the ends of the section, where the cut wall (collinear with it) ends, so that no
         particle slips out at a corner.
         """
-        p = model.particles
         s, tau = self._coordinates(p.x, p.y)
         back = (s < 0.0) & (tau >= -self.dx_n) & (tau <= self.length + self.dx_n)
         if back.any():
@@ -161,8 +161,8 @@ class Inflow:
             x0, y0 = p.x[back], p.y[back]
             p.x[back] += shift * nx
             p.y[back] += shift * ny
-            if getattr(model, "flux_lines", None) is not None:
-                model.count_moves(x0, y0, p.x[back], p.y[back], p.m[back])
+            if site.count_moves is not None:
+                site.count_moves(x0, y0, p.x[back], p.y[back], p.m[back])
             p.u[back] -= 2.0 * w * nx
             p.v[back] -= 2.0 * w * ny
 
@@ -170,7 +170,7 @@ class Inflow:
         """Hydrograph volume up to ``t`` not yet injected [m3] (within about one row)."""
         return float(self.hydrograph.volume(0.0, t)) - self.volume_in
 
-    def _inject_row(self, model, t: float, s: float, cap: float) -> None:
+    def _inject_row(self, water: Water, t: float, s: float, cap: float) -> None:
         """Inject one row at normal offset ``s`` carrying the volume due up to ``t``.
 
         A row represents the strip of water [s - dx/2, s + dx/2] across the section; its
@@ -188,15 +188,14 @@ class Inflow:
         x, y = self._row(s)
         m = RHO_WATER * volume / self.count
         rho = m / area
-        model.particles.append(x=x, y=y, u=self.w_b * self.normal[0], v=self.w_b * self.normal[1],
+        water.particles.append(x=x, y=y, u=self.w_b * self.normal[0], v=self.w_b * self.normal[1],
                                m=np.full(self.count, m), rho=np.full(self.count, rho),
-                               h=np.full(self.count, self.h), born=model.steps)
+                               h=np.full(self.count, self.h), born=water.steps)
         self.volume_in += volume
-        model.volume_in += volume
+        water.volume_in += volume
 
-    def _update_state(self, model, t: float) -> None:
+    def _update_state(self, p, t: float) -> None:
         """(d_B, w_B) from q(t) = Q(t) / L and the water within 2 dx inside the section."""
-        p = model.particles
         s, tau = self._coordinates(p.x, p.y)
         near = (s > 0.0) & (s < 2.0 * self.dx_n) & (tau > 0.0) & (tau < self.length)
         if near.any():
@@ -207,9 +206,8 @@ class Inflow:
         q = float(self.hydrograph.discharge(t)) / self.length
         self.d_b, self.w_b, self.regime = inflow_state(q, d_i, w_i)
 
-    def add_ghosts(self, model) -> None:
+    def add_ghosts(self, p) -> None:
         """Append the buffer rows at s = phase, phase - dx, ... as ghost particles."""
-        p = model.particles
         if self.d_b < DEPTH_MIN_M:
             self._ghosts = slice(p.n, p.n)
             return
@@ -219,11 +217,10 @@ class Inflow:
         rho = RHO_WATER * self.d_b
         self._ghosts = p.append(x=x, y=np.concatenate(ys), m=rho * self.dx_l * self.dx_n,
                                 rho=rho, h=self.h)
-        self.impose(model)
+        self.impose(p, None)
 
-    def impose(self, model) -> None:
+    def impose(self, p, lists) -> None:
         """Reset the buffer particles to the boundary state (after the density solve)."""
-        p = model.particles
         g = self._ghosts
         rho = RHO_WATER * self.d_b
         p.rho[g] = rho

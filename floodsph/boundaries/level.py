@@ -35,6 +35,7 @@ import math
 import numpy as np
 
 from floodsph.boundaries.inflow import DEPTH_MIN_M, lattice_alpha_ratio
+from floodsph.boundaries.protocol import Site, Water
 from floodsph.boundaries.riemann import level_state
 from floodsph.boundaries.section import section_coordinates, section_opening
 from floodsph.boundaries.weir import bed_at
@@ -114,23 +115,24 @@ class LevelBoundary:
                 self.a[1] + tau * self.tangent[1] + s * self.normal[1])
 
     # -- the boundary protocol -------------------------------------------------------------
-    def apply(self, model, dt: float) -> None:
+    def apply(self, water: Water, site: Site, dt: float) -> None:
         """Move the buffer by w_B dt; buffer particles that crossed in become water, water that
         crossed out joins the buffer; refill the entering columns' buffers; then update
         (d_B, w_B) to the level at the step's end."""
-        t_end = model.t + dt
-        self._update_reach(model)
+        t_end = water.t + dt
+        p = water.particles
+        self._update_reach(p, site.neighbour_skin)
         if not self.seeded:
-            self._seed(model)
+            self._seed(p)
             self.seeded = True
         b = self.buffer
         b["s"] += self.w_b[self._column(b["tau"])] * dt
-        self._inject(model)
-        self._take_departed(model)
+        self._inject(water)
+        self._take_departed(water)
         b = self.buffer
         self._keep_buffer(b["s"] > -self.reach)
         self._refill()
-        self._update_state(model, t_end)
+        self._update_state(water.particles, t_end)
 
     def _column(self, tau) -> np.ndarray:
         """The column index of points at distance ``tau`` along the line."""
@@ -143,28 +145,26 @@ class LevelBoundary:
         self.buffer = {name: np.concatenate([self.buffer[name], values[name]])
                        for name in self.buffer}
 
-    def _update_reach(self, model) -> None:
+    def _update_reach(self, p, skin: float) -> None:
         """The buffer's depth behind the line [m]: the kernel reach 2 h (1 + skin) of the
         widest particle near it, water or buffer."""
-        p = model.particles
         s, _ = self._coordinates(p.x, p.y)
         h = [self.h, float(self.buffer["h"].max(initial=0.0))]
         near = np.abs(s) < 4.0 * self.h
         if near.any():
             h.append(float(p.h[near].max()))
-        self.reach = 2.0 * (1.0 + model.numerics.neighbour_skin) * max(h)
+        self.reach = 2.0 * (1.0 + skin) * max(h)
 
-    def _seed(self, model) -> None:
+    def _seed(self, p) -> None:
         """The first buffer: mirror images of the water within reach of the line, which
         continue the seeding lattice across it (still water at the boundary level stays),
         with the alpha / rho of that lattice (the seeds' own is not solved yet)."""
-        p = model.particles
         s, tau = self._coordinates(p.x, p.y)
         near = (s >= 0.0) & (s < self.reach) & (tau >= 0.0) & (tau < self.length)
         self._add_buffer(s=-s[near], tau=tau[near], area=p.m[near] / p.rho[near],
                          h=p.h[near], ratio=np.full(int(near.sum()), self.alpha_ratio))
 
-    def _inject(self, model) -> None:
+    def _inject(self, water: Water) -> None:
         """Buffer particles that crossed the line (s >= 0) become water of depth d_B, mass
         rho_w d_B A [kg] for their area A, counted in ``volume_in``, with the velocity they
         had as ghosts (entering at w_B instead, the far-end error of the tide benchmark was
@@ -182,25 +182,25 @@ class LevelBoundary:
         rho = RHO_WATER * self.d_b[col]
         m = rho * b["area"][crossed][wet]
         w = self.w_i[col]
-        model.particles.append(x=x, y=y, u=w * self.normal[0], v=w * self.normal[1], m=m,
-                               rho=rho, h=b["h"][crossed][wet], born=model.steps)
+        water.particles.append(x=x, y=y, u=w * self.normal[0], v=w * self.normal[1], m=m,
+                               rho=rho, h=b["h"][crossed][wet], born=water.steps)
         volume = float(m.sum()) / RHO_WATER
         self.volume_in += volume
-        model.volume_in += volume
+        water.volume_in += volume
         self._keep_buffer(~crossed)
 
-    def _take_departed(self, model) -> None:
+    def _take_departed(self, water: Water) -> None:
         """Water behind the line (s < 0 within the buffer's depth, 0 <= tau <= L) leaves:
         its volume m / rho_w is counted in ``volume_out`` and it joins the buffer, which so
         continues the water's own spacing (as the departed particles do at an open edge)."""
-        p = model.particles
+        p = water.particles
         s, tau = self._coordinates(p.x, p.y)
         out = (s < 0.0) & (s > -self.reach) & (tau >= 0.0) & (tau <= self.length)
         if not out.any():
             return
         volume = float(p.m[out].sum()) / RHO_WATER
         self.volume_out += volume
-        model.volume_out += volume
+        water.volume_out += volume
         self._add_buffer(s=s[out], tau=tau[out], area=p.m[out] / p.rho[out], h=p.h[out],
                          ratio=p.alpha[out] / p.rho[out])
         p.keep(~out)
@@ -223,12 +223,11 @@ class LevelBoundary:
                          area=np.full(col.size, self.dx_l * self.dx_n),
                          h=np.full(col.size, self.h), ratio=np.full(col.size, self.alpha_ratio))
 
-    def _update_state(self, model, t: float) -> None:
+    def _update_state(self, p, t: float) -> None:
         """(d_B, w_B) per column from eta(t) and the interior water: the particles within
         ``INTERIOR_BAND`` spacings inside the line; and the normal velocity the ghosts and
         the water entering carry (``add_ghosts``): w_I, their mean, or w_B where the
         interior is dry."""
-        p = model.particles
         s, tau = self._coordinates(p.x, p.y)
         near = ((s > 0.0) & (s < INTERIOR_BAND * self.dx_n) & (tau >= 0.0)
                 & (tau < self.length))
@@ -244,7 +243,7 @@ class LevelBoundary:
         self.d_b, self.w_b = level_state(self.level - self.bed, d_i, w_i)
         self.w_i = np.where(wet, w_i, self.w_b)
 
-    def add_ghosts(self, model) -> None:
+    def add_ghosts(self, p) -> None:
         """Append the buffer particles of the columns with water (d_B > 0) as ghosts.
 
         They carry the boundary depth d_B but the interior's normal velocity w_I (a zero
@@ -264,13 +263,12 @@ class LevelBoundary:
         self._ghost_state = {"rho": rho, "m": rho * b["area"][wet], "h": b["h"][wet],
                              "alpha": rho * b["ratio"][wet], "u": w * self.normal[0],
                              "v": w * self.normal[1]}
-        self._ghosts = model.particles.append(
+        self._ghosts = p.append(
             x=self.a[0] + tau * self.tangent[0] + s * self.normal[0],
             y=self.a[1] + tau * self.tangent[1] + s * self.normal[1], **self._ghost_state)
 
-    def impose(self, model) -> None:
+    def impose(self, p, lists) -> None:
         """Reset the ghosts to their column's boundary state (after the density solve)."""
-        p = model.particles
         g = self._ghosts
         for name, values in self._ghost_state.items():
             getattr(p, name)[g] = values

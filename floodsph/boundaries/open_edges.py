@@ -31,6 +31,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from floodsph.boundaries.protocol import Site, Water
 from floodsph.constants import RHO_WATER
 from floodsph.sph.kernels import w_cubic
 
@@ -126,10 +127,10 @@ class OpenEdges:
         return x, 2.0 * self.height - y
 
     # -- the boundary protocol -------------------------------------------------------------
-    def apply(self, model, dt: float) -> None:
+    def apply(self, water: Water, site: Site, dt: float) -> None:
         """Move the buffer, take in the water that crossed an open side, drop what left reach."""
-        p = model.particles
-        self._update_reach(model)
+        p = water.particles
+        self._update_reach(p, site.neighbour_skin)
         if not self.seeded:
             self._seed(p)
             self.seeded = True
@@ -142,7 +143,7 @@ class OpenEdges:
             if crossed.any():
                 volume = float(p.m[crossed].sum()) / RHO_WATER
                 self.volume_out += volume
-                model.volume_out += volume
+                water.volume_out += volume
                 self._count_sides(p.m[crossed], beyond[:, crossed])
                 self._take(p, crossed)
                 p.keep(~crossed)
@@ -158,14 +159,13 @@ class OpenEdges:
         for name, v in zip(self.sides, volume, strict=True):
             self.volume_out_sides[name] += float(v)
 
-    def _update_reach(self, model) -> None:
-        p = model.particles
+    def _update_reach(self, p, skin: float) -> None:
         h = p.h
         reach = 0.0
         if p.n and self.sides:
             near = (self._beyond(p.x, p.y) > -2.0 * h).any(axis=0)
             if near.any():
-                reach = 2.0 * float(h[near].max()) * (1.0 + model.numerics.neighbour_skin)
+                reach = 2.0 * float(h[near].max()) * (1.0 + skin)
         self.reach = reach
 
     def _take(self, p, mask) -> None:
@@ -202,14 +202,13 @@ class OpenEdges:
             for name in _BUFFER_FIELDS:
                 b[name] = np.concatenate([b[name], new[name]])
 
-    def add_ghosts(self, model) -> None:
+    def add_ghosts(self, p) -> None:
         """Append the buffer as ghost particles."""
-        p = model.particles
         b = self.buffer
         self._ghosts = p.append(x=b["x"], y=b["y"], m=b["rho"] * b["area"], rho=b["rho"],
                                 alpha=b["alpha"], h=b["h"], u=b["u"], v=b["v"])
 
-    def impose(self, model) -> None:
+    def impose(self, p, lists) -> None:
         """Give each buffer particle the Shepard state of its water neighbours.
 
         Depth, velocity and alpha are the Shepard averages; the velocity's component normal
@@ -222,8 +221,7 @@ class OpenEdges:
         g = self._ghosts
         if g.stop == g.start:
             return
-        p = model.particles
-        nl = model.nl
+        nl = lists
         state = np.zeros((g.stop - g.start, 5))
         shepard_state(g.start, g.stop, g.start, p.x, p.y, p.m, p.rho, p.alpha, p.u, p.v, p.h,
                       nl.start, nl.nbr, state)

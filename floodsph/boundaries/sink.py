@@ -2,7 +2,7 @@
 
 A particle is absorbed when the DEM cell it stands in has its centre inside the sink polygon
 (even-odd rule, ``floodsph.io.polygons.points_in_polygon``), so the sink edge follows the DEM
-grid. Its volume m / rho_w is added to ``model.volume_out``. Water beyond the edge of the
+grid. Its volume m / rho_w is added to ``water.volume_out``. Water beyond the edge of the
 model is not simulated: a sink is an absorbing boundary, which is what a receiving water body
 far larger than the flood is: only the water that floods the scene is modelled
 (``docs/method.md`` §8).
@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from floodsph.boundaries.protocol import Site, Water
 from floodsph.constants import RHO_WATER
 from floodsph.io.polygons import points_in_polygon
 
@@ -53,20 +54,20 @@ class Sink:
         row = np.clip(np.floor(y / self.dy).astype(np.int64), 0, ny - 1)
         return grid[row, col]
 
-    def apply(self, model, dt: float) -> None:
+    def apply(self, water: Water, site: Site, dt: float) -> None:
         """Remove the particles inside the sink and count their volume as outflow."""
-        p = model.particles
+        p = water.particles
         inside = self._lookup(self.mask, p.x, p.y)
         if inside.any():
             volume = float(p.m[inside].sum()) / RHO_WATER
             self.volume_out += volume
-            model.volume_out += volume
+            water.volume_out += volume
             p.keep(~inside)
 
-    def add_ghosts(self, model) -> None:
+    def add_ghosts(self, p) -> None:
         """A sink has no ghosts."""
 
-    def impose(self, model) -> None:
+    def impose(self, p, lists) -> None:
         """A sink imposes no state."""
 
     opening = None

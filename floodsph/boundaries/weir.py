@@ -40,6 +40,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from floodsph.boundaries.crest import Crest
+from floodsph.boundaries.protocol import Site, Water
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.sph.kernels import seeded_smoothing_length
 
@@ -177,11 +178,10 @@ class Weir:
         return self.crest.at(self.chainage, t)
 
     # -- the levels on both sides ----------------------------------------------------------
-    def measure(self, model):
+    def measure(self, p, site: Site):
         """Levels [m] on both sides of every piece, (pieces, 2): side 1 is the side the piece
         normal (the tangent turned left) points to; -inf where dry. Also returns the members
         (particle indices, piece, side) and the mean depths (pieces, 2) [m]."""
-        p = model.particles
         idx, piece, _ = self._near(p.x, p.y, self.reach + GAUGE_OFFSET * self.h0)
         rel_x = p.x[idx] - self.mid[piece, 0]
         rel_y = p.y[idx] - self.mid[piece, 1]
@@ -191,9 +191,9 @@ class Weir:
         off = np.abs(normal) - GAUGE_OFFSET * self.h0
         dist = np.hypot(along, off)  # from the gauge point of the particle's side
         depth = p.rho[idx] / RHO_WATER
-        if model.balanced:
+        if site.balanced:
             depth = depth + p.eta_offset[idx]
-        eta = depth + bed_at(model.terrain, p.x[idx], p.y[idx])
+        eta = depth + bed_at(site.terrain, p.x[idx], p.y[idx])
         w = p.m[idx] / p.rho[idx] * _kernel(dist / self.h0)
         cell = 2 * piece + side
         size = 2 * self.pieces
@@ -204,13 +204,13 @@ class Weir:
         return level.reshape(-1, 2), (idx, piece, side), mean_depth.reshape(-1, 2)
 
     # -- the boundary protocol -------------------------------------------------------------
-    def apply(self, model, dt: float) -> None:
+    def apply(self, water: Water, site: Site, dt: float) -> None:
         """Pass Q dt over each piece's crest (module docstring), exactly in mass."""
-        p = model.particles
+        p = water.particles
         if dt <= 0.0 or p.n == 0:
             return
-        t = model.t + dt
-        level, (idx, piece, side), depth = self.measure(model)
+        t = water.t + dt
+        level, (idx, piece, side), depth = self.measure(p, site)
         crest = self.crest_now(t)
         up = np.argmax(level, axis=1)
         rows = np.arange(self.pieces)
@@ -240,7 +240,8 @@ class Weir:
                 continue
             gap = np.abs((p.x[members] - self.mid[k, 0]) * self.normal[k, 0]
                          + (p.y[members] - self.mid[k, 1]) * self.normal[k, 1])
-            mass = self._take(model, members, gap, d_e[k] * self.length[k] * self.dx, drop)
+            mass = self._take(p, site.balanced, members, gap,
+                              d_e[k] * self.length[k] * self.dx, drop)
             if mass <= 0.0:
                 continue
             volume = mass / RHO_WATER
@@ -254,13 +255,12 @@ class Weir:
             p.keep(~drop)
         if new:
             fields = {key: np.array([n[key] for n in new]) for key in new[0]}
-            p.append(**fields, born=model.steps)
+            p.append(**fields, born=water.steps)
 
-    def _take(self, model, members: np.ndarray, wall_distance: np.ndarray, volume: float,
-              drop: np.ndarray) -> float:
+    def _take(self, p, balanced: bool, members: np.ndarray, wall_distance: np.ndarray,
+              volume: float, drop: np.ndarray) -> float:
         """Take about ``volume`` [m3] from the particles ``members`` nearest the wall first
         (module docstring); mark those taken whole in ``drop``; return the mass taken [kg]."""
-        p = model.particles
         order = np.argsort(wall_distance, kind="stable")
         members = members[order]
         m = p.m[members]
@@ -278,7 +278,7 @@ class Weir:
         p.m[cut] = m[part] - taken[part]
         p.h0[cut] *= np.sqrt(keep)  # h = h0 (rho0 / rho)^(1/2) with rho0 h0^2 ~ m
         drop[members[whole]] = True
-        if model.balanced:
+        if balanced:
             from floodsph.sph.level_offsets import HELD, RELEASED
 
             held = cut[p.bank_held[cut] == HELD]
@@ -296,10 +296,10 @@ class Weir:
         return {"x": pos[0], "y": pos[1], "u": speed * n_down[0], "v": speed * n_down[1],
                 "m": mass, "rho": rho, "h": self.kappa * math.sqrt(mass / rho)}
 
-    def add_ghosts(self, model) -> None:
+    def add_ghosts(self, p) -> None:
         """A weir has no ghosts."""
 
-    def impose(self, model) -> None:
+    def impose(self, p, lists) -> None:
         """A weir imposes no state."""
 
     def max_dt(self, cfl: float) -> float:

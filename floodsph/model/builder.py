@@ -11,11 +11,12 @@ step. In order:
 4. seeds are moved off nodata and wall lines (``floodsph.walls.nodata.settle_seeds``), and
    those off the grid (or on open nodata) removed as outflow;
 5. neighbour lists and the density solve settle h from the seeding guess
-   (``FloodModel.interactions(settle=True)``);
+   (``floodsph.model.stages.interactions(settle=True)``);
 6. seeds of still water by walls are settled and their masses matched to the seeded depth
-   (``floodsph.model.wall_seeds``); ``model.volume_seed_adjustment`` [m3] is the change; under
+   (``floodsph.model.wall_seeds``); ``state.volume_seed_adjustment`` [m3] is the change; under
    the balanced momentum instead, every particle seeded at rest is given the level offset
-   that makes its level its seeded level (``floodsph.sph.level_offsets``);
+   that makes its level its seeded level (:func:`match_levels`,
+   ``floodsph.sph.level_offsets``);
 7. the first time step dt = cfl min h / (|v| + c).
 """
 
@@ -23,15 +24,20 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+import numpy as np
+
 from floodsph.boundaries.open_edges import SIDES as OPEN_SIDES
 from floodsph.boundaries.open_edges import OpenEdges
 from floodsph.constants import RHO_WATER
+from floodsph.model.domain import Domain
 from floodsph.model.flood_model import FloodModel
 from floodsph.model.particles import ParticleSet
+from floodsph.model.stages import Parts, interactions, remove_outside, stable_dt
 from floodsph.model.terrain import Terrain
 from floodsph.model.wall_layout import model_segments
 from floodsph.model.wall_seeds import settle_at_walls
 from floodsph.scenario.numerics import Numerics
+from floodsph.sph import level_offsets
 from floodsph.sph.kernels import seeded_smoothing_length
 from floodsph.walls.nodata import settle_seeds
 
@@ -61,7 +67,7 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
         Open boundaries (inflows, sinks).
     refiner : floodsph.model.refinement.Refiner or None
     held : (ny, nx) bool array or None
-        The DEM cells that held water at seeding (``FloodModel``).
+        The DEM cells that held water at seeding (``Domain.held``).
     level_sides : collection of str
         The sides taken by level boundaries (``floodsph.boundaries.level``, among
         ``boundaries``): neither walls nor open edges; the closed sides that meet them run on
@@ -88,31 +94,58 @@ def set_up_model(terrain: Terrain, particles: ParticleSet, numerics: Numerics, w
     seg = model_segments(terrain, walls, closed, walled, openings,
                          seeded_smoothing_length(numerics.kappa, numerics.particle_spacing_m),
                          numerics.particle_spacing_m)
-    model = FloodModel(terrain, particles, numerics, seg, closed, boundaries, refiner,
-                       held)
+    model = FloodModel(Domain.build(terrain, numerics, seg, closed, held), particles,
+                       boundaries, refiner)
+    parts = model.parts()
+    domain, state, work = parts.domain, parts.state, parts.work
     for boundary in model.boundaries:
-        boundary.apply(model, 0.0)
-    _seeds_off_walls(model, walled)
-    model.remove_outside(nodata=not walled)
-    rho_seed = model.particles.rho.copy()
-    model.interactions(settle=True)
-    if model.balanced:
-        model.match_levels()
+        boundary.apply(state, parts.site, 0.0)
+    _seeds_off_walls(domain, state, walled)
+    remove_outside(domain, state, nodata=not walled)
+    rho_seed = state.particles.rho.copy()
+    interactions(domain, state, work, model.boundaries, settle=True)
+    if domain.balanced:
+        match_levels(parts)
     else:
-        model.volume_seed_adjustment = settle_at_walls(model, rho_seed)
-    model.dt = model.stable_dt()
+        state.volume_seed_adjustment = settle_at_walls(parts, rho_seed)
+    state.dt = stable_dt(domain, state, model.boundaries)
     return model
 
 
-def _seeds_off_walls(model: FloodModel, walled: bool) -> None:
+def _seeds_off_walls(domain: Domain, state, walled: bool) -> None:
     """Move seeds off nodata and off wall lines (``settle_seeds``); those that cannot be moved
     are removed and counted as outflow."""
-    p, t = model.particles, model.terrain
-    spacing = model.numerics.particle_spacing_m
+    p, t = state.particles, domain.terrain
+    spacing = domain.numerics.particle_spacing_m
     assert spacing is not None  # set_up_model refuses a model without it
     x, y, lost = settle_seeds(p.x, p.y, t.valid, t.dx, t.dy, spacing,
-                              model.seg if walled else None)
+                              domain.seg if walled else None)
     p.x[:], p.y[:] = x, y
     if lost.any():
-        model.volume_out += float(p.m[lost].sum() / RHO_WATER)
+        state.volume_out += float(p.m[lost].sum() / RHO_WATER)
         p.keep(~lost)
+
+
+def match_levels(parts: Parts) -> int:
+    """Give every particle seeded at rest the level offset that makes its level its seeded
+    level (``floodsph.sph.level_offsets.match_offsets``), evaluate the forces again, and
+    mark as held by its banks each particle seeded at rest that has no free edge then
+    (``ParticleSet.bank_held``, ``floodsph.sph.level_momentum``); returns the number
+    matched. For the set-up, under the balanced momentum."""
+    domain, state = parts.domain, parts.state
+    p = state.particles
+    t = domain.terrain
+    bed = np.empty(p.n)
+    level_offsets.levels(p.x, p.y, np.zeros(p.n), np.zeros(p.n), t.elevation, t.dx, t.dy,
+                         bed)
+    matched = level_offsets.match_offsets(p.eta_seed, p.rho, bed, p.eta_offset)
+    p.bank_held[:] = level_offsets.FREE
+    interactions(domain, state, parts.work, parts.boundaries)
+    free_edge = np.zeros(p.n, dtype=bool)
+    evaluated = min(p.n, state.ghost.shape[0])  # no ghost array when all water moves
+    free_edge[:evaluated] = state.ghost[:evaluated] > 0.0
+    at_rest = np.isfinite(p.eta_seed) & (p.u == 0.0) & (p.v == 0.0)
+    p.bank_held[:] = np.where(at_rest & ~free_edge, level_offsets.HELD, level_offsets.FREE)
+    p.x_seed[:] = p.x
+    p.y_seed[:] = p.y
+    return matched

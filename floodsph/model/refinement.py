@@ -17,7 +17,7 @@ below is a ``refine_*`` field of ``floodsph.scenario.numerics.Numerics``: area_m
 * merge a and b when A < area_min A0 for both, each is the other's nearest such candidate, they are
   closer than min(h_a, h_b), neither is near a wall (none within the kernel reach of the
   larger of h and the merged particle's lattice h, kappa sqrt(2 A)) or in an open boundary's
-  zone (``FloodModel.protected``), neither was born (split, merge or inflow) in the last
+  zone (:func:`protected`), neither was born (split, merge or inflow) in the last
   ``no_merge_steps`` steps, |d_a - d_b| <= depth_jump max(d_a, d_b) and
   |v_a - v_b| <= speed_jump sqrt(g max(d_a, d_b)) (no merging across fronts and bores);
 * absorb a small candidate t (A_t < SMALL_FRACTION area_min A0) that found no such pair into
@@ -63,6 +63,8 @@ import numpy as np
 from floodsph.constants import GRAVITY, RHO_WATER
 from floodsph.errors import InputError
 from floodsph.model.particles import INHERITED
+from floodsph.model.refinement_site import RefinementSite, count_refinement_moves, protected
+from floodsph.model.state import State
 from floodsph.scenario.numerics import SMOOTHING_EXCESS, Momentum, Numerics
 
 HEXAGON_MARGIN = 1.01
@@ -107,7 +109,7 @@ class Refiner:
         self.spacing = float(spacing)
         self.area_max = numerics.refine_area_max * self.spacing**2
         self.area_min = numerics.refine_area_min * self.spacing**2
-        self.last_call = -1  # model.steps at the last apply: merges are due every
+        self.last_call = -1  # state.steps at the last apply: merges are due every
         # refine_merge_interval steps, also when a call ends several (local time stepping)
 
     @classmethod
@@ -118,54 +120,56 @@ class Refiner:
     def __repr__(self) -> str:
         return f"Refiner({self.numerics.refinement}, spacing={self.spacing})"
 
-    def apply(self, model) -> tuple[int, int]:
-        """Split and coalesce the particles of ``model`` in place; return (splits, merges).
+    def apply(self, state: State, site: RefinementSite) -> tuple[int, int]:
+        """Split and coalesce the particles of ``state`` in place; return (splits, merges).
 
-        Called by ``FloodModel.step`` after the drift and the density prediction; the step
-        then rebuilds the neighbour lists and solves density and h for all particles. Every
-        call first relaxes over-smoothed particles (:func:`relax_smoothing`), by the
-        compounded rate of the steps since the last call (several with local time stepping).
+        Called by ``floodsph.model.stages.synchronise`` after the drift and the density
+        prediction; the step then rebuilds the neighbour lists and solves density and h for
+        all particles. Every call first relaxes over-smoothed particles
+        (:func:`relax_smoothing`), by the compounded rate of the steps since the last call
+        (several with local time stepping).
         """
         s = self.numerics
-        steps = model.steps - self.last_call
+        steps = state.steps - self.last_call
         every = s.refine_merge_interval
-        merge_due = model.steps // every != self.last_call // every
-        self.last_call = model.steps
-        if not s.refinement.splits or model.particles.n == 0:
+        merge_due = state.steps // every != self.last_call // every
+        self.last_call = state.steps
+        if not s.refinement.splits or state.particles.n == 0:
             return 0, 0
         rate = RELAX_RATE if steps == 1 else 1.0 - (1.0 - RELAX_RATE) ** steps
-        relax_smoothing(model.particles, model.numerics.kappa, rate, s.refine_smoothing_excess)
-        parents = self.split_candidates(model)
+        relax_smoothing(state.particles, site.domain.numerics.kappa, rate,
+                        s.refine_smoothing_excess)
+        parents = self.split_candidates(state, site)
         a = b = np.zeros(0, dtype=np.int64)
         if s.refinement.coalesces and merge_due:
-            a, b = self.merge_pairs(model)
+            a, b = self.merge_pairs(state, site)
         if parents.size == 0 and a.size == 0:
             return 0, 0
-        return self.execute(model, parents, a, b)
+        return self.execute(state, site, parents, a, b)
 
-    def execute(self, model, parents, a, b) -> tuple[int, int]:
+    def execute(self, state: State, site: RefinementSite, parents, a, b) -> tuple[int, int]:
         """Split the particles ``parents`` and merge the pairs (a[k], b[k]); return the counts.
 
         The index arrays refer to the current particle order and must be disjoint. The
         parents and the pairs are removed, the daughters and merged particles appended, and the
-        model's neighbour lists dropped; the step rebuilds them (with the boundaries' ghosts)
-        and solves density and h.
+        neighbour lists dropped (``site.particles_changed``); the step rebuilds them (with the
+        boundaries' ghosts) and solves density and h.
         """
         parents, a, b = (np.asarray(i, dtype=np.int64) for i in (parents, a, b))
-        born = self._split(model, parents)
-        merged = self._merged(model, a, b)
-        if getattr(model, "flux_lines", None) is not None:
-            _count_refinement_moves(model, parents, a, b, born, merged)
-        keep = np.ones(model.particles.n, dtype=bool)
+        born = self._split(state, site, parents)
+        merged = self._merged(state, site, a, b)
+        if site.count_moves is not None:
+            count_refinement_moves(site, state.particles, parents, a, b, born, merged)
+        keep = np.ones(state.particles.n, dtype=bool)
         keep[parents] = False
         keep[a] = False
         keep[b] = False
-        p = model.particles
+        p = state.particles
         p.keep(keep)
         for fields in (born, merged):
             if fields is not None:
                 p.append(**fields)
-        model.particles_changed()
+        site.particles_changed()
         return int(parents.size), int(a.size)
 
     def still(self, p) -> np.ndarray:
@@ -177,26 +181,27 @@ class Refiner:
         return p.u * p.u + p.v * p.v < STILL_SPEED * STILL_SPEED
 
     # -- splitting ---------------------------------------------------------------------------
-    def split_candidates(self, model) -> np.ndarray:
+    def split_candidates(self, state: State, site: RefinementSite) -> np.ndarray:
         """Indices of the particles to split (criteria in the module docstring)."""
         from floodsph.sph import refine
 
-        p = model.particles
+        p = state.particles
         s = self.numerics
         big = (p.m > self.area_max * p.rho) & (p.rho >= RHO_WATER * s.refine_d_min_m)
         big &= p.level < s.refine_max_level
         big &= ~self.still(p)
-        for boundary in getattr(model, "boundaries", ()):
+        for boundary in site.boundaries:
             big &= ~boundary.protected(p.x, p.y)
         idx = np.flatnonzero(big)
         if idx.size == 0:
             return idx
-        h_parent = _parent_h(p, idx, model.numerics.kappa, s.refine_smoothing_excess)
+        h_parent = _parent_h(p, idx, site.domain.numerics.kappa, s.refine_smoothing_excess)
         x, y, _ = _daughter_positions(p, idx, h_parent)
-        walled = bool(model.closed_sides)
-        ok = model.terrain.covers(x, y, valid_only=not walled)  # walled nodata slivers are wet area
-        ok = ok.reshape(-1, refine.DAUGHTERS).all(axis=1)
-        wi = model.wall_index
+        walled = bool(site.domain.closed_sides)
+        # walled nodata slivers are wet area
+        covered = site.domain.terrain.covers(x, y, valid_only=not walled)
+        ok = covered.reshape(-1, refine.DAUGHTERS).all(axis=1)
+        wi = site.domain.wall_index
         if wi.seg.shape[0]:
             n = idx.size
             d = refine.DAUGHTERS
@@ -209,38 +214,38 @@ class Refiner:
             ok &= clear
         return idx[ok]
 
-    def _split(self, model, idx) -> dict | None:
+    def _split(self, state: State, site: RefinementSite, idx) -> dict | None:
         """Fields of the daughters of the parents ``idx`` (None if there are none)."""
         from floodsph.sph import refine
 
         if idx.size == 0:
             return None
-        p = model.particles
-        h_parent = _parent_h(p, idx, model.numerics.kappa,
+        p = state.particles
+        h_parent = _parent_h(p, idx, site.domain.numerics.kappa,
                              self.numerics.refine_smoothing_excess)
         x, y, m = _daughter_positions(p, idx, h_parent)
         rep = np.repeat(idx, refine.DAUGHTERS)
         h = refine.H_FACTOR * np.repeat(h_parent, refine.DAUGHTERS)
         rho = p.rho[rep]
         return dict(x=x, y=y, u=p.u[rep], v=p.v[rep], m=m, rho=rho, h=h, h0=h, rho0=rho,
-                    alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, model.steps),
+                    alpha=2.0 * rho, level=p.level[rep] + 1, born=np.full(x.size, state.steps),
                     stride=p.stride[rep], **{g: getattr(p, g)[rep] for g in INHERITED})
 
     # -- coalescing --------------------------------------------------------------------------
-    def merge_pairs(self, model) -> tuple[np.ndarray, np.ndarray]:
+    def merge_pairs(self, state: State, site: RefinementSite) -> tuple[np.ndarray, np.ndarray]:
         """Index arrays (a, b) of the particle pairs to merge (module docstring): the mutual
         nearest candidates (a < b), then the small candidates left and their absorbers
         (:meth:`_absorptions`; a is the small one)."""
-        p = model.particles
+        p = state.particles
         idx = np.flatnonzero((p.m < self.area_min * p.rho)
-                             & (model.steps - p.born >= self.numerics.refine_no_merge_steps)
+                             & (state.steps - p.born >= self.numerics.refine_no_merge_steps)
                              & ~self.still(p))
         if idx.size:  # the wall test covers the support of the merged particle, too
-            reach_h = np.maximum(p.h[idx], model.numerics.kappa
+            reach_h = np.maximum(p.h[idx], site.domain.numerics.kappa
                                  * np.sqrt(2.0 * p.m[idx] / p.rho[idx]))
-            idx = idx[~model.protected(p.x[idx], p.y[idx], reach_h)]
+            idx = idx[~protected(site, p.x[idx], p.y[idx], reach_h)]
         a, b = self._mutual_pairs(p, idx)
-        small_a, small_b = self._absorptions(model, idx, np.concatenate([a, b]))
+        small_a, small_b = self._absorptions(state, site, idx, np.concatenate([a, b]))
         return np.concatenate([a, small_a]), np.concatenate([b, small_b])
 
     def _mutual_pairs(self, p, idx) -> tuple[np.ndarray, np.ndarray]:
@@ -274,14 +279,15 @@ class Refiner:
         ok &= r < np.minimum(p.h[a], p.h[b])
         return a[ok], b[ok]
 
-    def _absorptions(self, model, cand, paired) -> tuple[np.ndarray, np.ndarray]:
+    def _absorptions(self, state: State, site: RefinementSite, cand,
+                     paired) -> tuple[np.ndarray, np.ndarray]:
         """Pairs (t, b) in which a small particle t is absorbed by a larger neighbour b.
 
         t is a merge candidate left unpaired (``cand`` minus ``paired``) with an area below
         SMALL_FRACTION area_min, and b its nearest particle that is neither small nor paired;
         of the small particles with the same b only the closest is absorbed, so no particle is
         in two merges. b must be settled (born at least ``no_merge_steps`` ago), away from
-        walls and open boundaries (``FloodModel.protected``, over the merged particle's lattice
+        walls and open boundaries (:func:`protected`, over the merged particle's lattice
         support), closer than h_b, with A_t + A_b < 2 area_min (the merged particle does not
         split at once) and |v_t - v_b| <= speed_jump sqrt(g d_b). There is no depth test
         (across a bore or a front the speeds differ too): with h below half of its
@@ -291,7 +297,7 @@ class Refiner:
         from floodsph.sph import refine
         from floodsph.sph.neighbours import NeighbourList
 
-        p = model.particles
+        p = state.particles
         empty = np.zeros(0, dtype=np.int64)
         small = np.setdiff1d(cand[p.m[cand] < SMALL_FRACTION * self.area_min * p.rho[cand]],
                              paired)
@@ -302,7 +308,7 @@ class Refiner:
         partner = np.ones(n, dtype=np.bool_)
         partner[paired] = False
         partner[small] = False
-        partner &= model.steps - p.born[:n] >= self.numerics.refine_no_merge_steps
+        partner &= state.steps - p.born[:n] >= self.numerics.refine_no_merge_steps
         nn = np.full(n, -1, dtype=np.int64)
         refine.nearest_of(small, p.x, p.y, near.start, near.nbr, partner, nn)
         t = small[nn[small] >= 0]
@@ -319,45 +325,31 @@ class Refiner:
         ok &= p.m[t] / p.rho[t] + p.m[b] / p.rho[b] < 2.0 * self.area_min
         t, b = t[ok], b[ok]
         if t.size:
-            reach_h = np.maximum(p.h[b], model.numerics.kappa
+            reach_h = np.maximum(p.h[b], site.domain.numerics.kappa
                                  * np.sqrt((p.m[t] + p.m[b]) / p.rho[b]))
-            clear = ~model.protected(p.x[b], p.y[b], reach_h)
+            clear = ~protected(site, p.x[b], p.y[b], reach_h)
             t, b = t[clear], b[clear]
         return t, b
 
     @staticmethod
-    def _merged(model, a, b) -> dict | None:
+    def _merged(state: State, site: RefinementSite, a, b) -> dict | None:
         """Fields of the particles merged from the pairs (a, b) (None if there are none)."""
         from floodsph.sph import refine
 
         if a.size == 0:
             return None
-        p = model.particles
+        p = state.particles
         out = np.empty((a.size, 7))
-        refine.merge_pairs(a, b, p.x, p.y, p.u, p.v, p.m, p.rho, p.h, model.numerics.kappa, out)
+        refine.merge_pairs(a, b, p.x, p.y, p.u, p.v, p.m, p.rho, p.h,
+                           site.domain.numerics.kappa, out)
         rho, h = out[:, 5], out[:, 6]
         wa = p.m[a] / (p.m[a] + p.m[b])
         inherited = {g: wa * getattr(p, g)[a] + (1.0 - wa) * getattr(p, g)[b]
                      for g in INHERITED}
         return dict(x=out[:, 0], y=out[:, 1], u=out[:, 2], v=out[:, 3], m=out[:, 4], rho=rho,
                     h=h, h0=h, rho0=rho, alpha=2.0 * rho, **inherited,
-                    level=np.minimum(p.level[a], p.level[b]), born=np.full(a.size, model.steps),
+                    level=np.minimum(p.level[a], p.level[b]), born=np.full(a.size, state.steps),
                     stride=np.minimum(p.stride[a], p.stride[b]))
-
-
-def _count_refinement_moves(model, parents, a, b, born, merged) -> None:
-    """Tell the model's flux lines where refinement moved water: each parent's mass to its
-    daughters (each with the daughter's mass), each pair's masses to the merged particle."""
-    from floodsph.sph import refine
-
-    p = model.particles
-    if born is not None:
-        rep = np.repeat(parents, refine.DAUGHTERS)
-        model.count_moves(p.x[rep], p.y[rep], born["x"], born["y"], born["m"])
-    if merged is not None:
-        both = np.concatenate([a, b])
-        model.count_moves(p.x[both], p.y[both], np.tile(merged["x"], 2),
-                          np.tile(merged["y"], 2), p.m[both])
 
 
 def relax_smoothing(p, kappa: float, rate: float = RELAX_RATE,

@@ -207,12 +207,12 @@ def error_message(exc: BaseException) -> str:
 
 
 def _record_setup(manifest: dict, model) -> None:
-    manifest["seeds_settled"] = model.counters["seeds_settled"]
-    manifest["volume_seed_adjustment_m3"] = model.volume_seed_adjustment
-    if model.counters["seeds_settled"]:
+    manifest["seeds_settled"] = model.state.counters["seeds_settled"]
+    manifest["volume_seed_adjustment_m3"] = model.state.volume_seed_adjustment
+    if model.state.counters["seeds_settled"]:
         log.info("%d seeds settled next to walls in %d rounds; volume adjusted by %.6g m3",
-                 model.counters["seeds_settled"], model.counters["settle_steps"],
-                 model.volume_seed_adjustment)
+                 model.state.counters["seeds_settled"], model.state.counters["settle_steps"],
+                 model.state.volume_seed_adjustment)
 
 
 def _write_outputs(manifest: dict, recorders, mass, work: Path, features) -> None:
@@ -305,7 +305,7 @@ def _simulation(scenario, inputs, model, folder, opts, checkpoint, stop, manifes
     work = folder.work
     source = None if checkpoint is None else str(checkpoint.path)
     state = None if checkpoint is None else checkpoint.recorders
-    mass = MassBalance(inputs.volume_initial_m3 + model.volume_seed_adjustment,
+    mass = MassBalance(inputs.volume_initial_m3 + model.state.volume_seed_adjustment,
                        None if checkpoint is None else checkpoint.mass_rows)
     bar = Progress(scenario.end_time_s, enabled=opts.progress)
     recorders = Recorders(scenario, inputs.terrain, inputs.gauges, work, state=state,
@@ -372,7 +372,7 @@ def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
     manifest["wall_time_s"] = wall_time
     if model is None:
         return
-    counters = getattr(model, "counters", {})
+    counters = model.state.counters
     manifest.update(
         sim_time_s=float(model.t),
         steps=int(model.steps),
@@ -382,8 +382,8 @@ def _finish_manifest(manifest: dict, model, mass, wall_time: float) -> None:
         merges=int(counters.get("merges", 0)),
         particle_updates=int(counters.get("particle_updates", 0)),
         volume_domain_m3=float(model.volume()),
-        volume_in_m3=float(model.volume_in),
-        volume_out_m3=float(model.volume_out),
+        volume_in_m3=float(model.state.volume_in),
+        volume_out_m3=float(model.state.volume_out),
         inflows=[_inflow_summary(b) for b in model.boundaries if isinstance(b, Inflow)],
         **outflow_summary(model),
     )
@@ -420,7 +420,7 @@ def outflow_summary(model) -> dict:
             levels[boundary.name] = float(boundary.volume_out)
     return {"volume_out_sinks_m3": sinks, "volume_out_sides_m3": sides,
             "volume_out_levels_m3": levels,
-            "volume_out_other_m3": float(getattr(model, "volume_out_other", 0.0))}
+            "volume_out_other_m3": float(model.state.volume_out_other)}
 
 
 def _inflow_summary(inflow) -> dict:

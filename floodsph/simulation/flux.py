@@ -6,8 +6,8 @@ over the line: positive when it goes from the left of the direction of travel (A
 A_k) to the right, negative the other way. Every displacement of water is counted, so the
 volume is exact, with no interpolation of depth or velocity onto the line:
 
-* the drift of each step, x^n -> x^{n+1} (``FloodModel.move``; walls reflect a move, and
-  the chord from the old to the new position is counted);
+* the drift of each step, x^n -> x^{n+1} (``floodsph.model.stages.move``; walls reflect a
+  move, and the chord from the old to the new position is counted);
 * the daughters of a split (parent -> each daughter, with the daughter's mass) and a
   coalesced pair (each of the two -> the merged particle, with its own mass,
   ``floodsph.model.refinement``);

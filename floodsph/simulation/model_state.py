@@ -7,13 +7,14 @@ lines) and :func:`restore_model` then sets, field by field, what changed while t
 interrupted run went. Each part declares its own state (``STATE``,
 ``floodsph.simulation.state_arrays``); the tree, by the names a checkpoint gives them:
 
-* ``model.*``: ``FloodModel.STATE`` (the clock, volumes, counters, per-particle arrays of
-  the last step);
+* ``model.*``: ``State.STATE`` of the model's ``state`` (``floodsph.model.state``: the
+  clock, volumes, counters, per-particle arrays of the last step);
 * ``model.particles.*``: ``ParticleSet.STATE`` (``capacity``, ``n``, ``next_pid``, every
   field of the active particles);
-* ``model.lists.*``: the neighbour lists (``NeighbourList.STATE``; JSON null when the next
-  step rebuilds them), and ``model.walls_near.*``: the near-wall lists built with them;
-  ``model.blocked_current``: whether the blocked pairs belong to these lists;
+* ``model.lists.*``: the workspace's neighbour lists (``NeighbourList.STATE``; JSON null
+  when the next step rebuilds them), and ``model.walls_near.*``: the near-wall lists built
+  with them; ``model.blocked_current``: whether the blocked pairs belong to these lists
+  (``floodsph.model.workspace``);
 * ``model.boundaries.<i>.*``: each open boundary's ``STATE``, in the model's order, and
   ``model.boundary_kinds``, their class names;
 * ``model.refiner.*`` and ``model.flux_lines.*``, when the model has them.
@@ -36,17 +37,18 @@ from floodsph.walls.index import NearWalls
 
 PARTS = ("particles", "lists", "walls_near", "blocked_current", "boundaries",
          "boundary_kinds", "refiner", "flux_lines")
-"""The parts of the model's state beside ``FloodModel.STATE``."""
+"""The parts of the model's state beside ``State.STATE``."""
 
 
 def model_state(model) -> dict[str, Any]:
     """The state of ``model`` (module docstring)."""
-    state = capture(model)
+    work = model.work
+    state = capture(model.state)
     state.update(
-        particles=capture(model.particles),
-        lists=None if model.nl is None else capture(model.nl),
-        walls_near=model.walls_near._asdict(),
-        blocked_current=model.nl is not None and model._blocked_nl is model.nl,
+        particles=capture(model.state.particles),
+        lists=None if work.nl is None else capture(work.nl),
+        walls_near=work.walls_near._asdict(),
+        blocked_current=work.nl is not None and work.blocked_for is work.nl,
         boundaries={str(i): capture(b) for i, b in enumerate(model.boundaries)},
         boundary_kinds=[type(b).__name__ for b in model.boundaries],
         refiner=None if model.refiner is None else capture(model.refiner),
@@ -69,13 +71,14 @@ def restore_model(model, state: dict[str, Any], source: str) -> None:
     own = {name: value for name, value in state.items() if name not in PARTS}
     parts = {name: value for name, value in state.items() if name in PARTS}
     expect_fields(parts, PARTS, where, source)
-    restore(model, own, where, source)
-    restore(model.particles, parts["particles"], f"{where}.particles", source)
-    model.nl = _lists(model, parts["lists"], source)
-    template = model.walls_near._asdict()
-    model.walls_near = NearWalls(**conform(template, parts["walls_near"], f"{where}.walls_near",
-                                           source))
-    model._blocked_nl = model.nl if parts["blocked_current"] is True else None
+    work = model.work
+    restore(model.state, own, where, source)
+    restore(model.state.particles, parts["particles"], f"{where}.particles", source)
+    work.nl = _lists(work.nl, parts["lists"], source)
+    template = work.walls_near._asdict()
+    work.walls_near = NearWalls(**conform(template, parts["walls_near"], f"{where}.walls_near",
+                                          source))
+    work.blocked_for = work.nl if parts["blocked_current"] is True else None
     kinds = [type(b).__name__ for b in model.boundaries]
     if parts["boundary_kinds"] != kinds:
         raise InputError(f"{source}: the checkpointed model has the boundaries "
@@ -94,11 +97,12 @@ def restore_model(model, state: dict[str, Any], source: str) -> None:
             restore(part, parts[name], f"{where}.{name}", source)
 
 
-def _lists(model, state, source: str) -> NeighbourList | None:
-    """The neighbour lists of ``state`` (None: none, the next step builds them)."""
+def _lists(fresh: NeighbourList | None, state, source: str) -> NeighbourList | None:
+    """The neighbour lists of ``state`` (None: none, the next step builds them), read into
+    the fresh model's lists ``fresh`` where it has them."""
     if state is None:
         return None
     empty = np.zeros(0)
-    lists = model.nl if model.nl is not None else NeighbourList(empty, empty, empty)
+    lists = fresh if fresh is not None else NeighbourList(empty, empty, empty)
     restore(lists, state, "model.lists", source)
     return lists

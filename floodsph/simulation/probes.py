@@ -47,8 +47,8 @@ class MassBalance:
     def budget(self, model) -> MassBudget:
         """The water budget of ``model`` now."""
         v_domain = float(model.volume())
-        v_in = float(model.volume_in)
-        v_out = float(model.volume_out)
+        v_in = float(model.state.volume_in)
+        v_out = float(model.state.volume_out)
         error = v_domain - (self.volume_initial + v_in - v_out)
         rel = abs(error) / max(self.volume_initial + v_in, TINY_VOLUME_M3)
         return MassBudget(v_domain, v_in, v_out, error, rel)

@@ -131,19 +131,19 @@ def _run(model, t_end):
 
     Particle-steps are the model's ``particle_updates``: particles times steps with one global
     step, the particles updated in each finest step with local time stepping."""
-    pst = model.counters["particle_updates"]
+    pst = model.state.counters["particle_updates"]
     pairs = 0
     t0 = time.perf_counter()
     while model.t < t_end - 1e-9:
-        pairs += model.nl.count()
+        pairs += model.work.nl.count()
         model.step(t_end - model.t)
-    return time.perf_counter() - t0, model.counters["particle_updates"] - pst, pairs
+    return time.perf_counter() - t0, model.state.counters["particle_updates"] - pst, pairs
 
 
 def _labels(model) -> tuple[str, int, int, int, str]:
     """(refinement, particles_max, splits, merges, time_stepping) of a finished run, for
     ``CaseResult``."""
-    c = model.counters
+    c = model.state.counters
     num = model.numerics
     return (num.refinement.value, c["particles_max"], c["splits"], c["merges"],
             num.time_stepping.value)

@@ -60,7 +60,7 @@ building (118,400 particles, 4,612 seeds, ``benchmarks/still_water_at_walls.py``
 set-up from the time of 321 steps to that of 101, with the seeds ending where they did.
 
 The matching changes the seeded volume (+40 m3, 0.04 %, in the lake above); the model reports
-the change (``FloodModel.volume_seed_adjustment``, ``volume_seed_adjustment_m3`` in
+the change (``State.volume_seed_adjustment``, ``volume_seed_adjustment_m3`` in
 ``run.json``) and the mass balance starts from the adjusted volume. Walls along the lattice
 (a box, a building aligned with it) leave every seed as it was.
 

@@ -35,7 +35,7 @@ def test_stage_times_are_exclusive_and_add_up_to_the_wall_time():
     assert sum(seconds.values()) == pytest.approx(totals["wall_s"], rel=1e-9)
     assert sum(r["percent"] for r in rows) == pytest.approx(100.0, rel=1e-9)
     assert totals["steps"] == 40
-    assert model.counters["splits"] > 0
+    assert model.state.counters["splits"] > 0
 
 
 def test_map_update_timing_compares_the_band_and_point_gathers_on_the_same_cells():

@@ -71,9 +71,9 @@ def test_the_balanced_form_measures_the_balanced_momentum_and_counts_the_list_bu
     at rest has levels to balance), and every row says how often the lists were built: at
     least once in the run's steps and at most twice a step (the build at the step and the
     one repeat of a capped density solve)."""
-    assert step_cost.dam_break(10.0, "balanced").balanced
-    assert not step_cost.dam_break(10.0, "variational").balanced
-    assert step_cost.dam_break(10.0).balanced  # the checkout's default
+    assert step_cost.dam_break(10.0, "balanced").domain.balanced
+    assert not step_cost.dam_break(10.0, "variational").domain.balanced
+    assert step_cost.dam_break(10.0).domain.balanced  # the checkout's default
     out = tmp_path / "step-cost.md"
     assert step_cost.main(["--quick", "--momentum", "balanced", "--out", str(out)]) == 0
     text = out.read_text()

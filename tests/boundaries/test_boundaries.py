@@ -132,13 +132,13 @@ def test_floodplain_inflow_injects_the_hydrograph_volume():
     fronts, lags = [], []
     for t in np.arange(10.0, 241.0, 10.0):
         run_until(model, t)
-        lags.append(hg.volume(0.0, t) - model.volume_in)
+        lags.append(hg.volume(0.0, t) - model.state.volume_in)
         p = model.particles
         fronts.append(np.hypot(p.x, p.y - 100.0).max() if p.n else 0.0)
-        assert model.volume() == pytest.approx(model.volume_in, rel=1e-12)
+        assert model.volume() == pytest.approx(model.state.volume_in, rel=1e-12)
     assert np.abs(lags).max() < row
-    assert model.volume_in == pytest.approx(hg.total_volume(), rel=1e-9)
-    assert model.volume_out == 0.0
+    assert model.state.volume_in == pytest.approx(hg.total_volume(), rel=1e-9)
+    assert model.state.volume_out == 0.0
     assert np.all(np.diff(fronts) > 0.0)
     assert fronts[-1] < 200.0  # no particle left the inlet area the wrong way or escaped
 
@@ -158,10 +158,10 @@ def test_injected_volume_matches_the_hydrograph_from_trickle_to_steep_rise(times
         run_until(model, t)
         v = hg.volume(0.0, t)
         row = critical_depth(hg.discharge(t) / 20.0) * 20.0 * dx
-        assert abs(model.volume_in - v) <= max(row, 0.005 * v), t
-        assert model.volume() == pytest.approx(model.volume_in, rel=1e-12)
+        assert abs(model.state.volume_in - v) <= max(row, 0.005 * v), t
+        assert model.volume() == pytest.approx(model.state.volume_in, rel=1e-12)
     run_until(model, times[-1] + 2.0)
-    assert model.volume_in == pytest.approx(hg.volume(0.0, model.t), rel=0.005)
+    assert model.state.volume_in == pytest.approx(hg.volume(0.0, model.t), rel=0.005)
 
 
 # -- outflow ------------------------------------------------------------------------------------
@@ -173,7 +173,7 @@ def test_still_water_at_an_open_edge_does_not_drain():
     v0 = model.volume()
     run_until(model, 200.0)
     p = model.particles
-    assert model.volume_out < 1e-6 * v0
+    assert model.state.volume_out < 1e-6 * v0
     assert np.hypot(p.u, p.v).max() < 0.01
     assert np.abs(model.depth() - 2.0).max() < 0.02
 
@@ -200,7 +200,7 @@ def test_uniform_flow_in_a_sloping_channel_stays_normal():
             assert d[reach].mean() == pytest.approx(d0, rel=0.03), (t, lo)
             assert p.u[reach].mean() == pytest.approx(q / d0, rel=0.03), (t, lo)
     # volume balance: what is in the channel is what it started with, plus in, minus out
-    v_expected = length * width * d0 + model.volume_in - model.volume_out
+    v_expected = length * width * d0 + model.state.volume_in - model.state.volume_out
     assert model.volume() == pytest.approx(v_expected, rel=1e-12)
 
 
@@ -240,11 +240,11 @@ def test_waves_leave_an_open_edge_without_reflection(d_right, t_end):
         d_exact, _ = exact.stoker(xq, t_end, 10.0, d_right, x_dam=1000.0)
         d_mid = exact.stoker_middle_state(10.0, d_right)[0]
         assert d_mid / exact.stoker_middle_state(10.0, d_right)[1] ** 2 * GRAVITY > 1  # Fr < 1
-    assert short.volume_out > 0.0
+    assert short.state.volume_out > 0.0
     assert np.abs(d_short - d_long).mean() < 0.01 * 10.0
     l1_short, l1_long = metrics.l1_relative(d_short, d_exact), metrics.l1_relative(d_long, d_exact)
     assert l1_short < 1.2 * l1_long + 0.005
-    assert short.volume() + short.volume_out == pytest.approx(v0, rel=1e-12)
+    assert short.volume() + short.state.volume_out == pytest.approx(v0, rel=1e-12)
 
 
 # -- sinks ----------------------------------------------------------------------------------------
@@ -259,8 +259,8 @@ def test_sink_absorbs_and_counts_the_water_that_reaches_it():
     v0 = model.volume()
     run_until(model, 120.0)
     p = model.particles
-    assert model.volume_out > 0.05 * v0
-    assert model.volume() + model.volume_out == pytest.approx(v0, rel=1e-12)
+    assert model.state.volume_out > 0.05 * v0
+    assert model.volume() + model.state.volume_out == pytest.approx(v0, rel=1e-12)
     assert not np.any(p.x >= 700.0)
     assert sink.protected(np.array([650.0, 300.0]), np.array([20.0, 20.0])).tolist() == [
         True, False]

@@ -149,11 +149,12 @@ def test_volume_balance_closes_while_the_level_rises_and_falls():
     v0 = model.volume()
     for t in (30.0, 60.0, 120.0, 180.0, 200.0):
         run_until(model, t)
-        balance = v0 + model.volume_in - model.volume_out - model.volume()
+        balance = v0 + model.state.volume_in - model.state.volume_out - model.volume()
         assert abs(balance) <= 1e-12 * v0, t
         assert model.volume() / (40.0 * 10.0) == pytest.approx(boundary.level, abs=0.1), t
     assert boundary.volume_in > 0.25 * v0 and boundary.volume_out > 0.6 * v0
-    assert (model.volume_in, model.volume_out) == (boundary.volume_in, boundary.volume_out)
+    assert ((model.state.volume_in, model.state.volume_out)
+            == (boundary.volume_in, boundary.volume_out))
 
 
 def test_a_level_raised_half_a_metre_fills_the_basin_to_it():

@@ -163,7 +163,7 @@ def test_the_weir_moves_water_without_making_or_losing_any(settings):
     run_until(model, 4.0)
     assert weir.volume_passed > 1.0  # about a third of the water above the crest
     assert model.volume() == pytest.approx(v0, rel=1e-12)
-    assert model.volume_out == 0.0
+    assert model.state.volume_out == 0.0
     downstream = model.particles.x > RESERVOIR
     assert model.particles.m[downstream].sum() / 1000.0 == pytest.approx(weir.volume_net,
                                                                          rel=1e-12)

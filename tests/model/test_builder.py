@@ -39,8 +39,8 @@ def test_seeds_off_the_grid_leave_as_outflow_and_the_volume_adds_up():
     terrain, p = _lake(extra_x=(110.0, 130.0))
     seeded = p.volume()
     model = set_up_model(terrain, p, Numerics(particle_spacing_m=DX), closed_sides=())
-    assert model.volume_out == pytest.approx(2 * 2.0 * DX * DX, rel=1e-12)
-    assert model.volume() + model.volume_out == pytest.approx(seeded, rel=1e-12)
+    assert model.state.volume_out == pytest.approx(2 * 2.0 * DX * DX, rel=1e-12)
+    assert model.volume() + model.state.volume_out == pytest.approx(seeded, rel=1e-12)
     assert model.particles.x.max() < terrain.width
 
 

@@ -14,6 +14,7 @@ from floodsph.constants import RHO_WATER
 from floodsph.errors import InputError
 from floodsph.model.builder import set_up_model
 from floodsph.model.refinement import Refiner
+from floodsph.model.refinement_site import protected
 from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
 from floodsph.scenario.numerics import (
@@ -65,6 +66,11 @@ def totals(p):
     return p.m.sum(), mom, np.sum(p.m * np.hypot(p.u, p.v))
 
 
+def on(model):
+    """The refiner's arguments for ``model``: its state, and what the refiner sees of it."""
+    return model.state, model.parts().refinement_site
+
+
 def shepard_depth(model, x, y):
     p = model.particles
     return interpolate(np.asarray(x), np.asarray(y), p.x, p.y, p.u, p.v, p.m, p.rho, p.h)[0]
@@ -95,13 +101,13 @@ def test_each_split_conserves_mass_and_momentum():
                           v=lambda x, y: -0.5 + 0.05 * x)
     p = model.particles
     refiner = split_only()
-    parents = refiner.split_candidates(model)
+    parents = refiner.split_candidates(*on(model))
     interior = parents[(p.x[parents] > 3) & (p.x[parents] < 27)]
     m_p, mu_p, mv_p = p.m[interior].copy(), (p.m * p.u)[interior], (p.m * p.v)[interior]
     x_p, y_p, h_p = p.x[interior].copy(), p.y[interior].copy(), p.h[interior].copy()
     heading = np.arctan2(p.v[interior], p.u[interior])
     mass0, mom0, scale = totals(p)
-    assert refiner.execute(model, interior, [], []) == (interior.size, 0)
+    assert refiner.execute(*on(model), interior, [], []) == (interior.size, 0)
     daughters = slice(p.n - 7 * interior.size, p.n)
     m_k = p.m[daughters].reshape(-1, 7)
     assert np.allclose(m_k.sum(axis=1), m_p, rtol=1e-14, atol=0.0)
@@ -128,7 +134,7 @@ def test_split_keeps_the_depth_of_uniform_water():
         model = model_on(flat, (0, 40), (0, 40), 1.0, 1.0, 1.0, momentum=Momentum.VARIATIONAL)
         p = model.particles
         parents = np.flatnonzero(np.hypot(p.x - centre, p.y - centre) < radius)
-        split_only().execute(model, parents, [], [])
+        split_only().execute(*on(model), parents, [], [])
         solve_in_place(model)
         born = p.level > 0
         assert born.sum() == 7 * parents.size
@@ -146,17 +152,17 @@ def test_no_split_across_a_wall_or_below_d_min_or_beyond_max_level():
                        walls=[np.array([[wall_x, 0.0], [wall_x, 20.0]])])
     p = model.particles
     refiner = split_only(refine_max_level=1)
-    parents = refiner.split_candidates(model)
+    parents = refiner.split_candidates(*on(model))
     hexagon = refine.EPS * p.h[parents]
     assert np.all(np.abs(p.x[parents] - wall_x) > hexagon)
     assert np.any((np.abs(p.x - wall_x) < 0.3) & (p.y < 10.0))  # left whole by the wall
     assert np.all(p.rho[parents] >= RHO_WATER * 0.01)
-    refiner.execute(model, parents, [], [])
+    refiner.execute(*on(model), parents, [], [])
     p = model.particles
     on_west = p.x[p.level > 0] < wall_x
     parent_west = np.repeat(np.asarray(on_west[::7]), 7)
     assert np.array_equal(on_west, parent_west)  # every family on its parent's side
-    assert refiner.split_candidates(model).size == 0  # daughters are at max_level
+    assert refiner.split_candidates(*on(model)).size == 0  # daughters are at max_level
 
 
 # -- coalescing ----------------------------------------------------------------------------------
@@ -184,14 +190,14 @@ def test_each_merge_conserves_mass_and_momentum():
     p = model.particles
     refiner = make_refiner(1.0, refine_area_max=20.0, refine_area_min=2.0, refine_no_merge_steps=0,
                            refine_depth_jump=0.2)
-    a, b = refiner.merge_pairs(model)
+    a, b = refiner.merge_pairs(*on(model))
     assert a.size > 50
     assert len(set(a) | set(b)) == 2 * a.size  # each particle in one pair at most
     pair_m = p.m[a] + p.m[b]
     pair_mu = (p.m * p.u)[a] + (p.m * p.u)[b]
     pair_mv = (p.m * p.v)[a] + (p.m * p.v)[b]
     mass0, mom0, scale = totals(p)
-    assert refiner.execute(model, [], a, b) == (0, a.size)
+    assert refiner.execute(*on(model), [], a, b) == (0, a.size)
     merged = slice(p.n - a.size, p.n)
     assert np.allclose(p.m[merged], pair_m, rtol=1e-15, atol=0.0)
     assert np.allclose((p.m * p.u)[merged], pair_mu, rtol=1e-13)
@@ -208,7 +214,7 @@ def test_merge_keeps_the_depth_at_the_merged_position():
 
     refiner = make_refiner(1.0, refine_area_max=20.0, refine_area_min=2.0, refine_no_merge_steps=0)
     model = jittered_pond(depth)
-    a, b = refiner.merge_pairs(model)
+    a, b = refiner.merge_pairs(*on(model))
     p = model.particles
     w = p.m[a] / (p.m[a] + p.m[b])
     xm, ym = w * p.x[a] + (1 - w) * p.x[b], w * p.y[a] + (1 - w) * p.y[b]
@@ -216,7 +222,7 @@ def test_merge_keeps_the_depth_at_the_merged_position():
     for k in inner:
         model = jittered_pond(depth)
         before = shepard_depth(model, xm[k:k + 1], ym[k:k + 1])[0]
-        refiner.execute(model, [], a[k:k + 1], b[k:k + 1])
+        refiner.execute(*on(model), [], a[k:k + 1], b[k:k + 1])
         solve_in_place(model)
         p = model.particles
         merged = np.argmax(p.m)
@@ -252,7 +258,7 @@ def test_a_small_particle_among_large_ones_is_absorbed_by_its_nearest():
     model, small = pond_with_small_particles(0.1, at)
     p = model.particles
     refiner = make_refiner(1.0, refine_area_max=2.0, refine_area_min=0.8, refine_no_merge_steps=0)
-    a, b = refiner.merge_pairs(model)  # the lattice's areas are 0.85-1.15: no candidates
+    a, b = refiner.merge_pairs(*on(model))  # the lattice's areas are 0.85-1.15: no candidates
     assert sorted(a) == sorted(small)
     for t, partner in zip(a, b, strict=True):
         r = np.hypot(p.x - p.x[t], p.y - p.y[t])
@@ -263,7 +269,7 @@ def test_a_small_particle_among_large_ones_is_absorbed_by_its_nearest():
     before = shepard_depth(model, xm, ym)
     dt0 = model.stable_dt()
     mass0, mom0, scale = totals(p)
-    assert refiner.execute(model, [], a, b) == (0, 2)
+    assert refiner.execute(*on(model), [], a, b) == (0, 2)
     mass1, mom1, _ = totals(p)
     assert abs(mass1 - mass0) <= 1e-12 * mass0
     assert np.all(np.abs(mom1 - mom0) <= 1e-12 * scale)
@@ -279,11 +285,11 @@ def test_a_small_particle_is_not_absorbed_where_the_merged_one_would_split():
     2 area_min (here 0.1 + 1.0 against 2 x 0.5), and none across a velocity jump."""
     model, small = pond_with_small_particles(0.1, np.array([[10.3, 12.6]]))
     tight = make_refiner(1.0, refine_area_max=2.0, refine_area_min=0.5, refine_no_merge_steps=0)
-    assert tight.merge_pairs(model)[0].size == 0
+    assert tight.merge_pairs(*on(model))[0].size == 0
     loose = make_refiner(1.0, refine_area_max=2.0, refine_area_min=0.8, refine_no_merge_steps=0)
-    assert loose.merge_pairs(model)[0].tolist() == small.tolist()
+    assert loose.merge_pairs(*on(model))[0].tolist() == small.tolist()
     model.particles.u[small] = 1.6  # against 0.5 sqrt(g d) = 1.57 m/s in 1 m of still water
-    assert loose.merge_pairs(model)[0].size == 0
+    assert loose.merge_pairs(*on(model))[0].size == 0
 
 
 def test_no_merge_near_walls_across_jumps_or_of_newborns():
@@ -291,14 +297,14 @@ def test_no_merge_near_walls_across_jumps_or_of_newborns():
     p = model.particles
     refiner = make_refiner(1.0, refine_area_max=20.0, refine_area_min=2.0, refine_no_merge_steps=0,
                            refine_depth_jump=0.2)
-    a, b = refiner.merge_pairs(model)
-    protected = model.protected(p.x, p.y, p.h)
-    assert not protected[a].any() and not protected[b].any()
-    assert protected.any()
+    a, b = refiner.merge_pairs(*on(model))
+    near_walls = protected(model.parts().refinement_site, p.x, p.y, p.h)
+    assert not near_walls[a].any() and not near_walls[b].any()
+    assert near_walls.any()
     d_a, d_b = p.rho[a], p.rho[b]
     assert np.all(np.abs(d_a - d_b) <= 0.2 * np.maximum(d_a, d_b))
     patient = make_refiner(1.0, refine_area_max=20.0, refine_area_min=2.0, refine_no_merge_steps=10)
-    assert patient.merge_pairs(model)[0].size == 0  # all born at step 0, now step 0
+    assert patient.merge_pairs(*on(model))[0].size == 0  # all born at step 0, now step 0
 
 
 def kinetic_energy(p):
@@ -314,15 +320,15 @@ def test_split_then_merge_operators_create_no_spurious_velocity():
     p = model.particles
     p.u[:], p.v[:] = 1.3, -0.4
     n0, mass0 = p.n, p.m.sum()
-    split_only().execute(model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
+    split_only().execute(*on(model), np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
     assert p.n > n0
     merger = make_refiner(1.0, refine_area_max=3.0, refine_area_min=0.3, refine_no_merge_steps=0)
     merges = 0
     for _ in range(10):
-        a, b = merger.merge_pairs(model)
+        a, b = merger.merge_pairs(*on(model))
         if a.size == 0:
             break
-        merges += merger.execute(model, [], a, b)[1]
+        merges += merger.execute(*on(model), [], a, b)[1]
     assert merges > 40
     assert np.abs(p.u - 1.3).max() < 1e-12 and np.abs(p.v + 0.4).max() < 1e-12
     assert abs(p.m.sum() - mass0) < 1e-12 * mass0
@@ -335,12 +341,12 @@ def pond_after_split_and_merge():
     end of the merging)."""
     model = model_on(flat, (0, 24), (0, 24), 1.0, 1.0, 1.0)
     p = model.particles
-    split_only().execute(model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
+    split_only().execute(*on(model), np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.5), [], [])
     merger = make_refiner(1.0, refine_area_max=3.0, refine_area_min=0.3, refine_no_merge_steps=0)
     merges = 0
     for _ in range(30):
         model.step()
-        merges += merger.execute(model, [], *merger.merge_pairs(model))[1]
+        merges += merger.execute(*on(model), [], *merger.merge_pairs(*on(model)))[1]
     speed0, energy0 = np.hypot(p.u, p.v).max(), kinetic_energy(p)
     for _ in range(150):
         model.step()
@@ -395,7 +401,7 @@ def test_the_thin_front_of_a_refined_dam_break_keeps_below_the_riemann_bound():
     while model.t < 40.0 - 1e-9:
         model.step(40.0 - model.t)
         fastest = max(fastest, np.hypot(model.particles.u, model.particles.v).max())
-    assert model.counters["splits"] > 0 and model.counters["merges"] > 0
+    assert model.state.counters["splits"] > 0 and model.state.counters["merges"] > 0
     assert fastest < 1.12 * 2.0 * math.sqrt(GRAVITY * 10.0)
 
 
@@ -420,7 +426,7 @@ def test_split_daughters_relax_to_sqrt3_lattice_smoothing_and_lattice_particles_
     h0_lattice = p.h0[0]
     assert np.all(p.h0 == h0_lattice)
     kappa = model.numerics.kappa
-    split_only().execute(model, np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.0), [], [])
+    split_only().execute(*on(model), np.flatnonzero(np.hypot(p.x - 12.0, p.y - 12.0) < 3.0), [], [])
     daughters = p.level > 0
     c0 = p.h0**2 * p.rho0
     target = SMOOTHING_EXCESS * kappa**2 * p.m
@@ -455,7 +461,7 @@ def test_a_parent_passes_on_at_most_its_relaxed_smoothing():
     relaxed = math.sqrt(SMOOTHING_EXCESS) * kappa * np.sqrt(p.m / p.rho)
     expect = refine.H_FACTOR * np.concatenate([relaxed[inflated], p.h[plain]])
     n0 = p.n - 4
-    split_only().execute(model, np.concatenate([inflated, plain]), [], [])
+    split_only().execute(*on(model), np.concatenate([inflated, plain]), [], [])
     born_h = p.h[n0:].reshape(4, refine.DAUGHTERS)
     np.testing.assert_allclose(born_h, np.repeat(expect[:, None], refine.DAUGHTERS, axis=1),
                                rtol=1e-12)
@@ -472,15 +478,15 @@ def test_the_refiner_relaxes_and_bounds_smoothing_to_its_own_smoothing_excess():
     bound = math.sqrt(2.0) * kappa * np.sqrt(p.m[centre] / p.rho[centre])
     n0 = p.n - centre.size
     refiner = split_only(refine_smoothing_excess=2.0)
-    refiner.execute(model, centre, [], [])
+    refiner.execute(*on(model), centre, [], [])
     np.testing.assert_allclose(p.h[n0:].reshape(-1, refine.DAUGHTERS),
                                np.repeat(refine.H_FACTOR * bound[:, None], refine.DAUGHTERS,
                                          axis=1), rtol=1e-12)
     daughters = p.level > 0
     relaxer = split_only(refine_area_max=1e9, refine_smoothing_excess=2.0)  # no further splits
     for step in range(1, 61):
-        model.steps = step  # Refiner.apply relaxes once per model step
-        assert relaxer.apply(model) == (0, 0)
+        model.state.steps = step  # Refiner.apply relaxes once per model step
+        assert relaxer.apply(*on(model)) == (0, 0)
     c = p.h0**2 * p.rho0 / (kappa**2 * p.m)
     np.testing.assert_allclose(c[daughters], 2.0, rtol=1e-5)
 

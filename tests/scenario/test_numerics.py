@@ -51,7 +51,7 @@ def test_the_scenarios_values_reach_the_model_under_their_own_names(write_scenar
     num = model.numerics
     assert (num.cfl, num.friction_depth_floor_m, num.kappa, num.max_slope,
             num.density_tol) == (0.25, 0.05, 1.3, 0.5, 1e-4)
-    assert num.stabilisation is Stabilisation.RIEMANN and model.scheme == forces.RIEMANN
+    assert num.stabilisation is Stabilisation.RIEMANN and model.domain.scheme == forces.RIEMANN
     assert num.particle_spacing_m == 10.0
 
 

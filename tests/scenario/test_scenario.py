@@ -272,7 +272,7 @@ def test_closed_sides_are_walls_and_the_other_sides_open(write_scenario):
     model = build_model(scenario, prepare_inputs(scenario))
     (edges,) = [b for b in model.boundaries if isinstance(b, OpenEdges)]
     assert set(edges.sides) == {"east", "south", "north"}
-    west = model.seg[(model.seg[:, 0] == 0.0) & (model.seg[:, 2] == 0.0)]
+    west = model.domain.seg[(model.domain.seg[:, 0] == 0.0) & (model.domain.seg[:, 2] == 0.0)]
     assert west.shape[0] == 1
     assert abs(west[0, 3] - west[0, 1]) >= model.terrain.height  # the whole side, and beyond
 

@@ -100,7 +100,7 @@ def test_a_lake_in_a_bowl_keeps_its_shore_and_is_not_refined():
     run_until(model, 30.0)
     p = model.particles
     assert max_speed(model) < 1e-9
-    assert model.counters["splits"] == 0 and model.counters["merges"] == 0
+    assert model.state.counters["splits"] == 0 and model.state.counters["merges"] == 0
     shore = (LEVEL_M + 1.0) / slope
     r = np.hypot(p.x - size / 2, p.y - size / 2)
     assert abs(r.max() - shore) < SPACING_M

@@ -70,9 +70,9 @@ def test_a_column_collapsing_in_a_closed_box_keeps_its_mass_and_stays_inside_wit
     p = model.particles
     n0, m0 = p.n, p.m.sum()
     run_until(model, 40.0)
-    assert model.counters["particle_updates"] < 0.99 * model.steps * p.n  # strides mixed
-    assert model.counters["wall_reflections"] > 0
-    assert p.n == n0 and model.volume_out == 0.0
+    assert model.state.counters["particle_updates"] < 0.99 * model.steps * p.n  # strides mixed
+    assert model.state.counters["wall_reflections"] > 0
+    assert p.n == n0 and model.state.volume_out == 0.0
     assert abs(p.m.sum() - m0) <= 1e-12 * m0
     assert p.x.min() >= 0 and p.x.max() <= 300 and p.y.min() >= 0 and p.y.max() <= 200
 
@@ -91,8 +91,8 @@ def test_local_steps_conserve_momentum_to_the_order_of_the_step():
     model = set_up_model(terrain, p, numerics, closed_sides=())
     mom0 = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     run_until(model, 20.0)
-    assert model.volume_out == 0.0
-    assert model.counters["particle_updates"] < 0.9 * model.steps * p.n  # measured 0.49
+    assert model.state.volume_out == 0.0
+    assert model.state.counters["particle_updates"] < 0.9 * model.steps * p.n  # measured 0.49
     mom = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     assert np.abs(mom - mom0).max() < 0.005 * math.hypot(*mom0)  # measured 0.11 %
 

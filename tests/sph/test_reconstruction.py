@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from floodsph.constants import RHO_WATER
+from floodsph.model import stages
 from floodsph.model.builder import set_up_model
 from floodsph.model.particles import ParticleSet
 from floodsph.model.terrain import Terrain
@@ -79,7 +80,7 @@ def test_muscl_pair_forces_conserve_momentum():
     model = set_up_model(terrain, p, Numerics(particle_spacing_m=10.0,
                                                stabilisation=Stabilisation.MUSCL,
                                                momentum=Momentum.VARIATIONAL))
-    model.interactions()
+    stages.interactions(model.domain, model.state, model.work, model.boundaries)
     assert np.abs(p.dudx).max() > 0.01  # the reconstruction is in play
     total = np.abs(np.sum(p.m * p.ax)) + np.abs(np.sum(p.m * p.ay))
     assert total < 1e-12 * np.sum(p.m * np.hypot(p.ax, p.ay))

@@ -4,6 +4,7 @@ import numpy as np
 from sph_cases import model_on, run_until
 
 from floodsph.constants import GRAVITY
+from floodsph.model import force_stages, list_stages
 from floodsph.scenario.numerics import Momentum
 from floodsph.sph import forces
 from floodsph.sph.sums import SUMS
@@ -15,13 +16,13 @@ def variational_acceleration(model):
     """The accelerations without the shore balance: the pair forces and the bed term alone."""
     p = model.particles
     ax, ay, divv = np.empty(p.n), np.empty(p.n), np.empty(p.n)
-    forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
+    forces.internal_acceleration(model.work.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
                                  p.kxx, p.kxy, p.kyy, p.dudx, p.dudy, p.dvdx, p.dvdy,
-                                 model.nl.start, model.nl.nbr, model.blocked,
-                                 model.wall_lists(), model.scheme, np.empty((p.n, SUMS)), ax,
-                                 ay, divv)
-    forces.add_bed_acceleration(model.nl.rows, p.u, p.v, model.bed, model.numerics.max_slope,
-                                ax, ay, GRAVITY, 0.0)
+                                 model.work.nl.start, model.work.nl.nbr, model.state.blocked,
+                                 list_stages.wall_lists(model.domain, model.state, model.work),
+                                 model.domain.scheme, np.empty((p.n, SUMS)), ax, ay, divv)
+    forces.add_bed_acceleration(model.work.nl.rows, p.u, p.v, model.state.bed,
+                                model.numerics.max_slope, ax, ay, GRAVITY, 0.0)
     return ax, ay
 
 
@@ -57,14 +58,14 @@ def test_a_front_running_downhill_keeps_its_push():
                         lambda x, y: np.where(x < 150, 4.0, 0.0), 10.0,
                         momentum=Momentum.VARIATIONAL)
 
-    assert not dam_break(lambda x, y: 0 * x).shores
+    assert not dam_break(lambda x, y: 0 * x).domain.shores
     model = dam_break(lambda x, y: -1e-3 * x)
     run_until(model, 10.0)
-    model.evaluate_forces()
+    force_stages.evaluate_forces(model.domain, model.state, model.work)
     p = model.particles
     ax, ay = variational_acceleration(model)
     front = p.x > p.x.max() - 2.0 * p.h.max()
-    assert model.shores and front.sum() > 10
+    assert model.domain.shores and front.sum() > 10
     np.testing.assert_array_equal(p.ax[front], ax[front])
     np.testing.assert_array_equal(p.ay[front], ay[front])
     assert np.hypot(p.ax - ax, p.ay - ay).max() < 1e-3
@@ -81,7 +82,7 @@ def test_the_shore_of_a_lake_in_a_bowl_stays_in_place():
     p = model.particles
     r0 = np.hypot(p.x - 500, p.y - 500).max()
     run_until(model, 200.0)
-    level = model.depth() + model.bed[:, 0]
+    level = model.depth() + model.state.bed[:, 0]
     assert np.abs(level - 5.0).max() < 0.01 * 5.0
     assert abs(np.hypot(p.x - 500, p.y - 500).max() - r0) < 10.0
     assert np.hypot(p.u, p.v).max() < 0.1

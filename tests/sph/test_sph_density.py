@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from sph_cases import lattice, model_on, particles_with_depth
 
+from floodsph.model import list_stages
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.scenario.numerics import Numerics
@@ -12,15 +13,17 @@ from floodsph.sph import density
 
 def solve(model, **kwargs):
     """``density.solve_density`` on the model's particles, lists and walls."""
-    return density.solve_density(model.particles, model.nl, model.blocked, model.wall_lists(),
+    return density.solve_density(model.particles, model.work.nl, model.state.blocked,
+                                 list_stages.wall_lists(model.domain, model.state, model.work),
                                  **kwargs)
 
 
 def summation(model, i):
     """(rho_i, alpha_i) of the density summation at particle i's current h."""
     p = model.particles
-    return density.summation(i, p.h[i], p.x, p.y, p.m, model.nl.start, model.nl.nbr,
-                             model.blocked, model.wall_lists())
+    return density.summation(i, p.h[i], p.x, p.y, p.m, model.work.nl.start, model.work.nl.nbr,
+                             model.state.blocked,
+                             list_stages.wall_lists(model.domain, model.state, model.work))
 
 
 def test_uniform_lattice_in_closed_box_gives_exact_depth_everywhere():
@@ -90,18 +93,18 @@ def test_capped_solve_keeps_the_lists_valid_and_catches_up_after_a_rebuild():
     i = p.n // 2 + 25
     p.rho[i] *= 1.0 / 0.7**2
     p.h[i] *= 0.7
-    model.update_lists(force=True)
-    model.block_pairs()
-    cap = model.nl.h_cap(p.x, p.y)[i]
+    list_stages.update_lists(model.domain, model.state, model.work, force=True)
+    list_stages.block_pairs(model.domain, model.state, model.work)
+    cap = model.work.nl.h_cap(p.x, p.y)[i]
     _, bad, capped, _ = solve(model, cap=True)
     assert capped == 1 and bad == 0
     assert p.h[i] == pytest.approx(cap) and p.h[i] < 0.8 * p.h0[i]
-    assert model.nl.still_valid(p.x, p.y, p.h)
+    assert model.work.nl.still_valid(p.x, p.y, p.h)
     rho_at_cap, _ = summation(model, i)
     assert p.rho[i] == pytest.approx(rho_at_cap, rel=1e-12)
     for _ in range(5):
-        model.update_lists(force=True)
-        model.block_pairs()
+        list_stages.update_lists(model.domain, model.state, model.work, force=True)
+        list_stages.block_pairs(model.domain, model.state, model.work)
         solve(model, cap=True)
     assert p.rho[i] / 3000.0 == pytest.approx(1.0, abs=2e-3)
 
@@ -122,8 +125,8 @@ def test_a_heavy_neighbour_brought_close_does_not_collapse_h_in_a_time_step():
     p.x[j] = p.x[i] + 0.05 * h_guess
     p.y[j] = p.y[i]
     p.m[j] *= 10.0
-    model.update_lists(force=True)
-    model.block_pairs()
+    list_stages.update_lists(model.domain, model.state, model.work, force=True)
+    list_stages.block_pairs(model.domain, model.state, model.work)
     _, bad, capped, held = solve(model, cap=True)
     assert bad == 0 and capped == 0 and held >= 1
     assert p.h[i] == pytest.approx(density.H_SHRINK_MIN * h_guess, rel=1e-12)

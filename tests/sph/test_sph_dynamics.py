@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from sph_cases import model_on, particles_with_depth, run_until
 
+from floodsph.model import list_stages, stages
 from floodsph.model.builder import set_up_model
 from floodsph.model.terrain import Terrain
 from floodsph.output.rasterise import interpolate
@@ -20,7 +21,7 @@ def test_closed_box_conserves_mass_and_keeps_every_particle_inside():
     run_until(model, 40.0)
     assert p.n == n0
     assert abs(p.m.sum() - m0) <= 1e-12 * m0
-    assert model.volume_out == 0.0
+    assert model.state.volume_out == 0.0
     assert p.x.min() >= 0 and p.x.max() <= 300 and p.y.min() >= 0 and p.y.max() <= 200
 
 
@@ -43,7 +44,7 @@ def test_momentum_changes_only_through_external_forces():
     mom0 = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     scale = (p.m * np.hypot(p.u, p.v)).sum()
     run_until(model, 20.0)
-    assert model.volume_out == 0.0
+    assert model.state.volume_out == 0.0
     mom = np.array([(p.m * p.u).sum(), (p.m * p.v).sum()])
     assert np.abs(mom - mom0).max() < 1e-12 * scale
 
@@ -159,8 +160,8 @@ def test_the_closer_a_particle_is_to_a_wall_the_harder_the_wall_pushes_it_back()
     for gap in (4.0, 3.0, 2.0, 1.0, 0.5, 0.1):
         k = np.flatnonzero(p.pid == pid)[0]
         p.y[k] = gap
-        model.nl = None
-        model.interactions()
+        model.work.nl = None
+        stages.interactions(model.domain, model.state, model.work, model.boundaries)
         k = np.flatnonzero(p.pid == pid)[0]
         push.append(p.ay[k])
     assert np.all(np.diff(push) > 0.0) and push[0] > 0.0
@@ -205,7 +206,7 @@ def test_lake_at_rest_over_a_bump_stays_at_rest():
     model = model_on(bump, (0, 1000), (0, 1000), 10.0, 10.0, 20.0)
     run_until(model, 200.0)
     p = model.particles
-    level = model.depth() + model.bed[:, 0]
+    level = model.depth() + model.state.bed[:, 0]
     assert np.hypot(p.u, p.v).max() < 0.01
     assert np.abs(level - 10.0).max() < 0.01 * 10.0
 
@@ -218,7 +219,7 @@ def test_lake_at_rest_in_a_parabolic_bowl_stays_at_rest():
     model = model_on(bowl, (0, 1000), (0, 1000), 10.0, 5.0, 10.0)
     run_until(model, 200.0)
     p = model.particles
-    level = model.depth() + model.bed[:, 0]
+    level = model.depth() + model.state.bed[:, 0]
     assert np.hypot(p.u, p.v).max() < 0.01
     assert np.abs(level - 5.0).max() < 0.01 * 5.0
 
@@ -239,26 +240,26 @@ def test_segments_beyond_reach_are_skipped_without_changing_density_or_forces():
                      lambda x, y: np.where(x < 60, 2.0, 0.0), 4.0, walls=[building])
     run_until(model, 20.0)
     p = model.particles
-    model.update_lists(force=True)
-    model.block_pairs()
-    wstart, wseg, cstart, cpair = model.walls_near
-    beyond = model.wdist >= 2.0 * np.repeat(p.h, np.diff(wstart))
+    list_stages.update_lists(model.domain, model.state, model.work, force=True)
+    list_stages.block_pairs(model.domain, model.state, model.work)
+    wstart, wseg, cstart, cpair = model.work.walls_near
+    beyond = model.state.wdist >= 2.0 * np.repeat(p.h, np.diff(wstart))
     assert p.h.max() > 2.0 * 1.3 * 4.0 and beyond.mean() > 0.3
 
     def results(wdist):
-        walls = model.wall_lists()._replace(wdist=wdist)
-        rho = [density.summation(i, p.h[i], p.x, p.y, p.m, model.nl.start, model.nl.nbr,
-                                 model.blocked, walls)
+        walls = list_stages.wall_lists(model.domain, model.state, model.work)._replace(wdist=wdist)
+        rho = [density.summation(i, p.h[i], p.x, p.y, p.m, model.work.nl.start, model.work.nl.nbr,
+                                 model.state.blocked, walls)
                for i in range(p.n)]
         acc = np.empty((3, p.n))
-        forces.internal_acceleration(model.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho, p.alpha, p.h,
-                                     p.kxx, p.kxy, p.kyy, p.dudx, p.dudy, p.dvdx, p.dvdy,
-                                     model.nl.start, model.nl.nbr,
-                                     model.blocked, walls, model.scheme, np.empty((p.n, SUMS)),
-                                     *acc)
+        forces.internal_acceleration(model.work.nl.rows, p.x, p.y, p.u, p.v, p.m, p.rho,
+                                     p.alpha, p.h, p.kxx, p.kxy, p.kyy, p.dudx, p.dudy, p.dvdx,
+                                     p.dvdy, model.work.nl.start, model.work.nl.nbr,
+                                     model.state.blocked, walls, model.domain.scheme,
+                                     np.empty((p.n, SUMS)), *acc)
         return np.array(rho), acc
 
-    rho, acc = results(model.wdist)
-    rho_all, acc_all = results(np.zeros_like(model.wdist))
+    rho, acc = results(model.state.wdist)
+    rho_all, acc_all = results(np.zeros_like(model.state.wdist))
     np.testing.assert_array_equal(rho, rho_all)
     np.testing.assert_array_equal(acc, acc_all)

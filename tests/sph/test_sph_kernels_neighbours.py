@@ -171,13 +171,13 @@ def test_verlet_lists_kept_over_steps_give_the_flow_of_lists_rebuilt_every_step(
         built, last = 0, None
         while model.t < 30.0:
             model.step()
-            built += model.nl is not last
-            last = model.nl
+            built += model.work.nl is not last
+            last = model.work.nl
         p = model.particles
         order = np.argsort(p.pid)
         states.append(np.c_[p.x, p.y, p.u, p.v, p.rho][order])
         lists.append((built, model.steps))
-        assert model.counters["density_capped"] == 0
+        assert model.state.counters["density_capped"] == 0
     (rebuilt, steps), (kept, steps_kept) = lists
     assert rebuilt >= 0.9 * steps and steps_kept == steps
     assert kept < steps / 2

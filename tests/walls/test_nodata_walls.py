@@ -188,7 +188,7 @@ def test_the_slivers_inside_the_walls_are_seeded_and_bring_the_water_up_to_them(
     row = np.floor(q.y[:q.n] / terrain.dy).astype(int)
     in_sliver = sliver[row, col]
     assert in_sliver.sum() == sliver.sum()  # one seed per cell at spacing = cell, none left
-    assert model.volume_out == 0.0 and q.n == plain.particles.n + sliver.sum()
+    assert model.state.volume_out == 0.0 and q.n == plain.particles.n + sliver.sum()
     assert np.percentile(plain.depth(), 5) < 1.7
     assert np.percentile(model.depth(), 5) > 1.9
 
@@ -201,16 +201,16 @@ def test_oblique_nodata_walls_hold_the_water():
     cell, or a nodata cell next to one)."""
     terrain, model, volume = lake_model()
     stair = sum(len(c) - 1 for c in nw.trace(terrain.valid))
-    assert model.seg.shape[0] - 4 < 0.35 * stair  # the 4 closed grid sides included
+    assert model.domain.seg.shape[0] - 4 < 0.35 * stair  # the 4 closed grid sides included
     n0 = model.particles.n
-    assert model.volume_out == 0.0
-    assert abs(model.volume_seed_adjustment) < 0.005 * volume  # seeds settled at the walls
-    volume += model.volume_seed_adjustment
+    assert model.state.volume_out == 0.0
+    assert abs(model.state.volume_seed_adjustment) < 0.005 * volume  # seeds settled at the walls
+    volume += model.state.volume_seed_adjustment
     assert abs(model.volume() - volume) < 1e-9 * volume
     while model.t < 40.0:
         model.step()
     q = model.particles
-    assert q.n == n0 and model.volume_out == 0.0
+    assert q.n == n0 and model.state.volume_out == 0.0
     assert abs(model.volume() - volume) < 1e-9 * volume
     col = np.floor(q.x[:q.n] / terrain.dx).astype(int)
     row = np.floor(q.y[:q.n] / terrain.dy).astype(int)

@@ -57,8 +57,8 @@ def test_the_adjustment_is_reported_and_small(turned_lake):
     """The seeds' volume changes by the reported ``volume_seed_adjustment`` only (measured
     +40 m3 of 107,900 m3), and masses move by at most the bounds."""
     model, seeded = turned_lake
-    assert model.volume() == pytest.approx(seeded + model.volume_seed_adjustment, rel=1e-12)
-    assert 0.0 < abs(model.volume_seed_adjustment) < 0.005 * seeded
+    assert model.volume() == pytest.approx(seeded + model.state.volume_seed_adjustment, rel=1e-12)
+    assert 0.0 < abs(model.state.volume_seed_adjustment) < 0.005 * seeded
     m = model.particles.m / (RHO_WATER * 2.0 * 25.0)
     assert m.min() >= wall_seeding.MASS_MIN - 1e-12 and m.max() <= wall_seeding.MASS_MAX + 1e-12
 
@@ -91,7 +91,7 @@ def test_walls_along_the_lattice_change_nothing():
     x, y = lattice(0.0, 800.0, 0.0, 600.0, 10.0)
     keep = depth(x, y) > 0
     p = model.particles
-    assert model.volume_seed_adjustment == 0.0
+    assert model.state.volume_seed_adjustment == 0.0
     np.testing.assert_array_equal(np.sort(p.x + 1e3 * p.y), np.sort(x[keep] + 1e3 * y[keep]))
     np.testing.assert_array_equal(p.m, RHO_WATER * 3.0 * 100.0)
 
@@ -107,10 +107,10 @@ def test_seeds_that_need_no_settling_leave_the_set_up_as_it_was(monkeypatch):
                         lambda x, y: np.where(x < 1000, 10.0, 0.0), 10.0, momentum=VARIATIONAL)
 
     model = build()
-    assert model.counters["seeds_settled"] > 500 and model.counters["settle_steps"] == 0
+    assert model.state.counters["seeds_settled"] > 500 and model.state.counters["settle_steps"] == 0
     monkeypatch.setattr(wall_seeds, "wall_seeds", lambda model, rho: np.zeros(0, np.int64))
     unsettled = build()
-    assert unsettled.counters["seeds_settled"] == 0
+    assert unsettled.state.counters["seeds_settled"] == 0
     for field in ("rho", "h", "hgrow", "ax", "ay", "kxx", "kxy", "kyy"):
         np.testing.assert_array_equal(getattr(model.particles, field),
                                       getattr(unsettled.particles, field), err_msg=field)
@@ -166,7 +166,7 @@ def test_settling_the_seeds_neighbourhood_alone_moves_them_as_settling_everythin
     monkeypatch.setattr(wall_seeding, "neighbourhood",
                         lambda rows, start, nbr, n, rings: np.arange(n, dtype=np.int64))
     everything = turned_rectangle_lake()
-    assert model.counters["seeds_settled"] == everything.counters["seeds_settled"] > 400
+    assert model.state.counters["seeds_settled"] == everything.state.counters["seeds_settled"] > 400
     p, q = model.particles, everything.particles
     np.testing.assert_allclose(p.x, q.x, rtol=0.0, atol=1e-9)
     np.testing.assert_allclose(p.y, q.y, rtol=0.0, atol=1e-9)
