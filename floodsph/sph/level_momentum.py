@@ -45,7 +45,7 @@ off (a Malpasset reservoir disturbed by 1e-6 m/s reached 3 m/s within 20 s, a sh
 particle's ghost switched on in the first step). Water seeded at rest whose support had no
 free edge at set-up therefore keeps none while it stays slower than ``EDGE_SPEED``
 (``bank_held`` = ``floodsph.sph.level_offsets.HELD``, set by
-``floodsph.model.flood_model.FloodModel.match_levels`` and released for good once the
+``floodsph.model.builder.match_levels`` and released for good once the
 particle reaches that speed; a departure of its level from its seeded level by
 ``HOLD_LEVEL`` ends the rest of the hold, ``floodsph.sph.level_offsets.BANKED``): its banks
 were tested once, on the seeded lake. Where its support is cut (|e_i| h_i >=
