@@ -64,9 +64,12 @@ def report(row: dict) -> str:
         f"| {row['end_time_s']:g} | {row['interval_s']:g} | {row['checkpoints']} | "
         f"{row['checkpoint_mb']:.1f} | {each:.2f} | {row['wall_time_s']:.1f} | {share:.2f} % |",
         "",
-        "A checkpoint holds every particle array, the neighbour and wall lists, the boundary",
-        "and refinement state and the envelope maps; the DEM is not stored. The share is the",
-        "time spent writing checkpoints over the run's wall time.",
+        "A checkpoint is one `checkpoint/state.npz` (format 5: named arrays, the scenario with",
+        "its SHA-256, read without unpickling anything): every particle array, the neighbour",
+        "and wall lists, the boundary and refinement state and the envelope maps. The DEM is",
+        "not stored: a resumed run builds its model from the scenario again and then restores",
+        "these arrays. The share is the time spent writing checkpoints over the run's wall",
+        "time, on all the machine's cores.",
         "",
     ])
 

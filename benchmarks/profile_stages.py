@@ -8,13 +8,18 @@ steps is ``other``. Prints a markdown
 table and the neighbour-list builds per step. The first steps compile the numba kernels when
 they are not cached yet: ``--warmup`` steps (default 3) run before the clock starts.
 
+``--functions N`` profiles the same steps again by function instead (``cProfile``, which adds
+its own cost to every Python call): the N functions of most own time, numba kernels each as
+one call, so that a stage's time can be traced to its kernels and to the array work around
+them.
+
 The stages leave out the run's recorders. ``--maps N`` then also times one update of the map
 envelopes' interpolation at the final state on the scenario's map grid, best of N: the band
 gather the run uses (``floodsph.output.rasterise.rasterise``) and the point gather of
 ``interpolate`` at every cell centre, with the largest depth difference between the two.
 
     python benchmarks/profile_stages.py SCENARIO.toml [--steps 500 | --end-time 600]
-        [--threads 2] [--warmup 3] [--maps 5]
+        [--threads 2] [--warmup 3] [--maps 5] [--functions 25]
 """
 
 from __future__ import annotations
@@ -34,8 +39,10 @@ def profile(model, steps: int | None = None, end_time: float | None = None,
 
     ``rows`` has one dict per stage of ``floodsph.model.stage_timer`` (``stage``, ``seconds``,
     ``percent``), most costly first, and ``other`` for the time outside the steps; ``totals``
-    the wall time, steps, particle-steps and neighbour-list builds per step (the model's
-    ``neighbour_builds`` counter) of the timed steps. The timer is the model's public hook
+    the wall time, steps, particle-steps (the particles at each ``step()``, a big step under
+    local time stepping), particle updates (the ``particle_updates`` counter: each particle's
+    own steps) and neighbour-list builds per step (the ``neighbour_builds`` counter) of the
+    timed steps. The timer is the model's public hook
     (``FloodModel.stage_timer``), removed again afterwards.
     """
     from floodsph.model.stage_timer import StageTimer
@@ -45,6 +52,7 @@ def profile(model, steps: int | None = None, end_time: float | None = None,
     timer = StageTimer()
     model.stage_timer = timer
     step0, builds0, particle_steps = model.steps, model.state.counters["neighbour_builds"], 0
+    updates0 = model.state.counters["particle_updates"]
     t0 = time.perf_counter()
     try:
         while (steps is None or model.steps - step0 < steps) and (
@@ -61,9 +69,38 @@ def profile(model, steps: int | None = None, end_time: float | None = None,
             for k, v in times.most_common()]
     totals = {"wall_s": wall, "steps": nsteps, "sim_time_s": model.t,
               "particle_steps": particle_steps,
+              "particle_updates": model.state.counters["particle_updates"] - updates0,
               "list_builds_per_step": (model.state.counters["neighbour_builds"] - builds0)
               / max(nsteps, 1)}
     return rows, totals
+
+
+def function_profile(model, steps: int | None = None, end_time: float | None = None,
+                     top: int = 25) -> list[dict]:
+    """Step ``model`` as :func:`profile` does (no warm-up) under ``cProfile``; the ``top``
+    functions by own time: ``function`` (module path and name), ``calls``, ``seconds`` and
+    ``percent`` of the profiled wall time."""
+    import cProfile
+    import pstats
+
+    step0 = model.steps
+    profiler = cProfile.Profile()
+    t0 = time.perf_counter()
+    profiler.enable()
+    while (steps is None or model.steps - step0 < steps) and (
+            end_time is None or model.t < end_time):
+        model.step()
+    profiler.disable()
+    wall = time.perf_counter() - t0
+    stats = pstats.Stats(profiler).stats  # type: ignore[attr-defined]  # its table
+    rows = []
+    for (path, _, name), (_, calls, own, _, _) in stats.items():
+        where = Path(path)
+        module = ".".join(where.with_suffix("").parts[-2:]) if path.endswith(".py") else path
+        rows.append({"function": f"{module}.{name}" if path.endswith(".py") else name,
+                     "calls": calls, "seconds": own, "percent": 100.0 * own / wall})
+    rows.sort(key=lambda row: -row["seconds"])
+    return rows[:top]
 
 
 def map_update_times(model, grid, repeats: int = 3) -> dict:
@@ -102,6 +139,8 @@ def main(argv=None) -> int:
     ap.add_argument("--end-time", type=float, default=None, help="or run up to this time [s]")
     ap.add_argument("--threads", type=int, default=0, help="numba threads (0 = all cores)")
     ap.add_argument("--warmup", type=int, default=3, help="untimed steps first")
+    ap.add_argument("--functions", type=int, default=0, metavar="N",
+                    help="then profile the same steps by function, the N of most own time")
     ap.add_argument("--maps", type=int, default=0, metavar="N",
                     help="also time a map update at the end, best of N")
     args = ap.parse_args(argv)
@@ -124,6 +163,13 @@ def main(argv=None) -> int:
     print(markdown(rows, spec=".3g"))
     print()
     print(markdown([totals], spec=".4g"))
+    if args.functions > 0:
+        again = build_model(scenario, inputs)
+        for _ in range(args.warmup):
+            again.step()
+        print()
+        print(markdown(function_profile(again, steps=steps, end_time=args.end_time,
+                                        top=args.functions), spec=".3g"))
     if args.maps > 0:
         from floodsph.output.grid import OutputGrid
 

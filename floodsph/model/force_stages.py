@@ -5,7 +5,7 @@ momentum the pressure and shock-capturing pair forces (``floodsph.sph.forces``, 
 by ``floodsph.sph.consistency``, balanced at walls by ``floodsph.sph.shadow`` and at shores
 by ``floodsph.sph.shore``) and the bed slope; under the balanced momentum the level gradient
 of ``floodsph.sph.level_momentum`` for slow water, blended with the variational forces as the
-water speeds up (``level_momentum.variational_weight``).
+water speeds up (``floodsph.sph.momentum_blend``).
 """
 
 from __future__ import annotations
@@ -18,7 +18,15 @@ from floodsph.model.list_stages import block_pairs, wall_lists
 from floodsph.model.state import State
 from floodsph.model.workspace import Workspace
 from floodsph.sph import bed as bedmod
-from floodsph.sph import consistency, forces, level_momentum, level_offsets, shadow, shore
+from floodsph.sph import (
+    consistency,
+    forces,
+    level_momentum,
+    level_offsets,
+    momentum_blend,
+    shadow,
+    shore,
+)
 from floodsph.sph.sums import SUMS
 from floodsph.sph.velocity_gradient import velocity_gradient
 
@@ -44,19 +52,19 @@ def evaluate_forces(domain: Domain, state: State, work: Workspace) -> None:
         state.eta = np.empty(p.n)
         state.ghost = np.zeros(p.n)
     level_offsets.levels(p.x, p.y, p.rho, p.eta_offset, t.elevation, t.dx, t.dy, state.eta)
-    _release(state, rows)
-    weight = level_momentum.variational_weight(p.u[rows], p.v[rows])
-    moving = rows[weight > 0.0]
+    momentum_blend.release(rows, p.u, p.v, state.eta, p.eta_seed, p.bank_held)
+    weight = np.empty(rows.shape[0])
+    momentum_blend.variational_weights(rows, p.u, p.v, weight)
+    taken = weight > 0.0
+    moving = rows[taken]
     if moving.size:
         _variational_forces(domain, state, work, moving)
-        a_var = np.stack([p.ax[moving], p.ay[moving], p.divv[moving]])
+        a_var = (p.ax[moving], p.ay[moving], p.divv[moving])
     slow = rows[weight < 1.0]
     if slow.size:
         _balanced_forces(domain, state, work, slow)
     if moving.size:
-        w = weight[weight > 0.0]
-        for field, value in zip((p.ax, p.ay, p.divv), a_var, strict=True):
-            field[moving] = w * value + (1.0 - w) * field[moving]
+        momentum_blend.blend(moving, weight[taken], *a_var, p.ax, p.ay, p.divv)
 
 
 def _variational_forces(domain: Domain, state: State, work: Workspace,
@@ -103,17 +111,3 @@ def _balanced_forces(domain: Domain, state: State, work: Workspace, rows: np.nda
                                          p.ax, p.ay, p.divv, state.ghost)
     forces.add_bed_acceleration(rows, p.u, p.v, state.bed, domain.numerics.max_slope, p.ax,
                                 p.ay, 0.0, -GRAVITY)
-
-
-def _release(state: State, rows: np.ndarray) -> None:
-    """Among ``rows``, bank the still water held by its banks whose level ``state.eta``
-    departs from its seeded level by ``HOLD_LEVEL``, and release the held or banked water
-    that moves at ``EDGE_SPEED`` (``floodsph.sph.level_momentum``,
-    ``floodsph.sph.level_offsets``)."""
-    p = state.particles
-    held = p.bank_held[rows]
-    fast = p.u[rows] ** 2 + p.v[rows] ** 2 >= level_momentum.EDGE_SPEED ** 2
-    departed = np.abs(state.eta[rows] - p.eta_seed[rows]) >= level_momentum.HOLD_LEVEL
-    p.bank_held[rows[(held == level_offsets.HELD) & departed]] = level_offsets.BANKED
-    kept = (held == level_offsets.HELD) | (held == level_offsets.BANKED)
-    p.bank_held[rows[kept & fast]] = level_offsets.RELEASED

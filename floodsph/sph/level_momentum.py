@@ -85,8 +85,9 @@ exact for a level and antisymmetric.
 Moving water. The level form's free edges push only the outermost row of a dry front, and a
 front that thins into a train of equally deep particles then coasts (Ritter at 10 m: L1 7.9 %
 against 1.9 %). Water faster than ``BLEND_SPEED`` therefore takes the variational force
-(``floodsph.sph.forces``), and slower water a blend (:func:`variational_weight`): a lake at
-rest is still exact, and a flood wave keeps the variational force's accuracy.
+(``floodsph.sph.forces``), and slower water a blend
+(``floodsph.sph.momentum_blend.variational_weight``): a lake at rest is still exact, and a
+flood wave keeps the variational force's accuracy.
 
 Units: accelerations [m s-2], levels and depths [m], rho [kg m-2], m [kg], h and r [m].
 """
@@ -119,7 +120,8 @@ COVER_REACH = 0.75
 COVER_MIN = 0.6
 """Shepard sum at x_g [-] at and above which there is water there (no ghost)."""
 BLEND_SPEED = 0.1
-"""Speed [m s-1] from which water takes the variational force alone (:func:`variational_weight`)."""
+"""Speed [m s-1] from which water takes the variational force alone
+(``floodsph.sph.momentum_blend.variational_weight``)."""
 HOLD_TIME = 1.0
 """Relaxation time [s] of the damping of still water held by its banks (module docstring;
 ``floodsph.sph.level_offsets.hold_still``)."""
@@ -381,12 +383,3 @@ def balanced_acceleration(rows, x, y, u, v, m, rho, alpha, h, eta, bed, nstart, 
         ay[i] = acc[1] - GRAVITY * (ixy * sx + iyy * sy)
         beta = 2.0 * rho[i] / alpha[i] if alpha[i] > 0.0 else 1.0
         divv[i] = -beta * (acc[9] + bank_div) / rho[i]
-
-
-
-def variational_weight(u, v):
-    """The weight [-] of the variational force in a particle's acceleration under the balanced
-    momentum, by its speed |v| [m s-1]: lambda = s^2 (3 - 2 s), s = min(|v| / ``BLEND_SPEED``,
-    1); a = lambda a_variational + (1 - lambda) a_balanced."""
-    s = np.minimum(np.hypot(u, v) / BLEND_SPEED, 1.0)
-    return s * s * (3.0 - 2.0 * s)

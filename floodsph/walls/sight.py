@@ -100,11 +100,11 @@ def _first_crossing(x0, y0, x1, y1, seg, candidates, lo, hi):
 
 
 @njit(inline="always", cache=True)
-def _bucket_of(px, py, xmin, ymin, bucket, nbx, nby):
-    """Flat index of the bucket of side ``bucket`` [m] holding (px, py) on a grid of nbx x nby
-    buckets from (xmin, ymin), or -1 outside it."""
-    cx = (px - xmin) / bucket
-    cy = (py - ymin) / bucket
+def _bucket_of(px, py, xmin, ymin, inv_bucket, nbx, nby):
+    """Flat index of the bucket holding (px, py) on a grid of nbx x nby square buckets of
+    side 1 / ``inv_bucket`` [m] from (xmin, ymin), or -1 outside it."""
+    cx = (px - xmin) * inv_bucket
+    cy = (py - ymin) * inv_bucket
     if 0.0 <= cx < nbx and 0.0 <= cy < nby:
         return int(cy) * nbx + int(cx)
     return -1
@@ -127,30 +127,39 @@ def drift(x, y, u, v, dt, seg, fine, near, every):
     """
     f_start, f_items, xmin, ymin, f_bucket, f_nbx, f_nby, f_radius = fine
     n_start, n_items, _, _, n_bucket, n_nbx, n_nby, n_radius = near
+    f_reach2 = (NEAR_SHARE * f_radius) ** 2
+    n_reach2 = (NEAR_SHARE * n_radius) ** 2
+    f_inv = 1.0 / f_bucket
+    n_inv = 1.0 / n_bucket
     total = 0
     for i in prange(x.shape[0]):
         x_old = x[i]
         y_old = y[i]
         x[i] = x_old + dt * u[i]
         y[i] = y_old + dt * v[i]
-        travel = math.hypot(x[i] - x_old, y[i] - y_old)
-        candidates = every
+        travel2 = (x[i] - x_old) ** 2 + (y[i] - y_old) ** 2
+        table = 0  # 1: the fine buckets' candidates, 2: the near ones', 0: every segment
         lo = 0
         hi = every.shape[0]
-        b = _bucket_of(x_old, y_old, xmin, ymin, f_bucket, f_nbx, f_nby)
-        if b >= 0 and travel < NEAR_SHARE * f_radius:
-            candidates = f_items
+        b = _bucket_of(x_old, y_old, xmin, ymin, f_inv, f_nbx, f_nby)
+        if b >= 0 and travel2 < f_reach2:
+            table = 1
             lo = f_start[b]
             hi = f_start[b + 1]
         else:
-            b = _bucket_of(x_old, y_old, xmin, ymin, n_bucket, n_nbx, n_nby)
-            if b >= 0 and travel < NEAR_SHARE * n_radius:
-                candidates = n_items
+            b = _bucket_of(x_old, y_old, xmin, ymin, n_inv, n_nbx, n_nby)
+            if b >= 0 and travel2 < n_reach2:
+                table = 2
                 lo = n_start[b]
                 hi = n_start[b + 1]
         hits = 0
-        for _ in range(3):
-            hit = _first_crossing(x_old, y_old, x[i], y[i], seg, candidates, lo, hi)
+        while lo < hi and hits < 3:
+            if table == 1:
+                hit = _first_crossing(x_old, y_old, x[i], y[i], seg, f_items, lo, hi)
+            elif table == 2:
+                hit = _first_crossing(x_old, y_old, x[i], y[i], seg, n_items, lo, hi)
+            else:
+                hit = _first_crossing(x_old, y_old, x[i], y[i], seg, every, lo, hi)
             if hit < 0:
                 break
             hits += 1

@@ -38,6 +38,18 @@ def test_stage_times_are_exclusive_and_add_up_to_the_wall_time():
     assert model.state.counters["splits"] > 0
 
 
+def test_the_function_profile_counts_each_kernel_call_of_the_steps():
+    """Profiled by function, 25 global steps call the drift's kernel (``walls.sight.drift``)
+    once each, and the rows' own times stay within the profiled wall time."""
+    model = model_on(lambda x, y: 0 * x, (0, 40), (0, 24), 1.0,
+                     lambda x, y: np.where(x < 12.0, 1.0, 0.0), 1.0)
+    model.step()
+    rows = prof.function_profile(model, steps=25, top=400)
+    calls = {r["function"]: r["calls"] for r in rows}
+    assert calls["walls.sight.drift"] == 25
+    assert 0.0 < sum(r["percent"] for r in rows) <= 100.0
+
+
 def test_map_update_timing_compares_the_band_and_point_gathers_on_the_same_cells():
     """After a dam break has spread (h from 1.3 to several times that), the two ways of
     interpolating onto the map grid map the same cells with the same depths."""

@@ -113,7 +113,7 @@ def test_a_dam_break_keeps_its_mass_exactly():
 
 def test_the_dam_breaks_at_10_m_keep_the_variational_bounds():
     """Moving water takes the variational force (the blend of
-    ``floodsph.sph.level_momentum.variational_weight``): Ritter, Stoker and Thacker stay within
+    ``floodsph.sph.momentum_blend.variational_weight``): Ritter, Stoker and Thacker stay within
     the bounds the default meets (L1 2.0 %, 0.65 %, and 2.5 % at 200 m)."""
     assert cases.ritter(10.0, momentum=Momentum.BALANCED).l1 <= 0.020
     assert cases.stoker(10.0, momentum=Momentum.BALANCED).l1 <= 0.0065
