@@ -94,6 +94,35 @@ def _in_cell_order(order, x, y, h, xs, ys, hs):
         hs[s] = h[j]
 
 
+@njit(cache=True)
+def _level_grids(level, lv_hmax, box, reach):
+    """The grid of each search level: its cell side [m], the reach R_L = ``reach`` times the
+    level's largest h, or coarser, sqrt(area / (members + 1)), where that would give more
+    cells than the level has particles; its cells across and along, and each level's offset
+    in the cells of all levels. An empty level (hmax 0) has one cell of side 0.
+
+    Returns (lv_cell, lv_ncx, lv_ncy, lv_off).
+    """
+    nlv = lv_hmax.shape[0]
+    members = np.zeros(nlv, dtype=np.int64)
+    for i in range(level.shape[0]):
+        members[level[i]] += 1
+    lv_cell = np.zeros(nlv)
+    lv_ncx = np.ones(nlv, dtype=np.int64)
+    lv_ncy = np.ones(nlv, dtype=np.int64)
+    lv_off = np.zeros(nlv + 1, dtype=np.int64)
+    for lv in range(nlv):
+        if lv_hmax[lv] > 0.0:
+            width = box[lv, 2] - box[lv, 0]
+            height = box[lv, 3] - box[lv, 1]
+            cell = max(reach * lv_hmax[lv], math.sqrt(width * height / (members[lv] + 1.0)))
+            lv_cell[lv] = cell
+            lv_ncx[lv] = int(math.floor(width / cell)) + 1
+            lv_ncy[lv] = int(math.floor(height / cell)) + 1
+        lv_off[lv + 1] = lv_off[lv] + lv_ncx[lv] * lv_ncy[lv]
+    return lv_cell, lv_ncx, lv_ncy, lv_off
+
+
 @njit(parallel=True, cache=True)
 def _level_cell_ids(x, y, level, box, lv_cell, lv_ncx, lv_ncy, lv_off, out):
     """Cell index ``off_L + cy * ncx_L + cx`` of every point on its level's grid."""
@@ -216,10 +245,27 @@ def _chunk_capacity(args, rows: np.ndarray) -> np.ndarray:
         return np.zeros(0, dtype=np.int64)
     found = np.empty(sample.shape[0], dtype=np.int64)
     _count(*args[:-1], sample, found)  # type: ignore[call-arg]  # a numba kernel
-    first = np.arange(0, sample.shape[0], CHUNK // SAMPLE_STRIDE)
-    mean = np.add.reduceat(found, first) / np.diff(np.append(first, sample.shape[0]))
-    size = np.minimum(rows.shape[0] - first * SAMPLE_STRIDE, CHUNK)
-    return (1.5 * size * mean + 2.0 * np.maximum.reduceat(found, first) + 64.0).astype(np.int64)
+    return _capacity(found, rows.shape[0])
+
+
+@njit(cache=True)
+def _capacity(found, nrows):
+    """Slots of each chunk of ``CHUNK`` of ``nrows`` rows (:func:`_chunk_capacity`) from the
+    neighbour counts ``found`` of every ``SAMPLE_STRIDE``-th row."""
+    per_chunk = CHUNK // SAMPLE_STRIDE
+    nchunk = (found.shape[0] + per_chunk - 1) // per_chunk
+    slots = np.empty(nchunk, dtype=np.int64)
+    for c in range(nchunk):
+        lo = c * per_chunk
+        hi = min(found.shape[0], lo + per_chunk)
+        total = 0
+        most = 0
+        for k in range(lo, hi):
+            total += found[k]
+            most = max(most, found[k])
+        size = min(nrows - lo * SAMPLE_STRIDE, CHUNK)
+        slots[c] = int(1.5 * size * (total / (hi - lo)) + 2.0 * most + 64.0)
+    return slots
 
 
 @njit(parallel=True, cache=True)
@@ -324,18 +370,7 @@ class NeighbourList:
             return
         level = np.empty(n, dtype=np.int64)
         lv_hmax, box = h_levels(x, y, h, LEVEL_BASE * float(np.median(h)), level)
-        used = lv_hmax > 0.0
-        width = np.where(used, box[:, 2] - box[:, 0], 0.0)
-        height = np.where(used, box[:, 3] - box[:, 1], 0.0)
-        members = np.bincount(level, minlength=lv_hmax.shape[0])
-        # cells of the level's reach, coarser where that would give more cells than particles
-        lv_cell = np.where(used, np.maximum(self.reach * lv_hmax,
-                                            np.sqrt(width * height / (members + 1.0))), 0.0)
-        safe = np.where(used, lv_cell, 1.0)
-        lv_ncx = np.where(used, np.floor(width / safe), 0).astype(np.int64) + 1
-        lv_ncy = np.where(used, np.floor(height / safe), 0).astype(np.int64) + 1
-        lv_off = np.zeros(lv_hmax.shape[0] + 1, dtype=np.int64)
-        np.cumsum(lv_ncx * lv_ncy, out=lv_off[1:])
+        lv_cell, lv_ncx, lv_ncy, lv_off = _level_grids(level, lv_hmax, box, self.reach)
         cid = np.empty(n, dtype=np.int64)
         _level_cell_ids(x, y, level, box, lv_cell, lv_ncx, lv_ncy, lv_off, cid)
         cell_start, order = counting_sort(cid, int(lv_off[-1]), chunks(n))
