@@ -40,48 +40,31 @@ SAMPLE_STRIDE = 32
 """Every SAMPLE_STRIDE-th row is counted first, to size the build's buffers."""
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def h_levels(x, y, h, h_c, level):
     """Search level of every particle into ``level``: 0 for h <= h_c, L >= 1 for h in
     (h_c 2^(L-1), h_c 2^L].
 
     Returns (hmax, box): the largest h of each level and its particles' bounding box
-    (x0, y0, x1, y1); an empty level has hmax 0. Parallel over chunks of ``CHUNK``
-    particles, each with its own largest h and box, merged after (maxima and minima: the
-    same numbers in any order).
+    (x0, y0, x1, y1); an empty level has hmax 0.
     """
-    n = h.shape[0]
-    nchunk = max((n + CHUNK - 1) // CHUNK, 1)
-    part_hmax = np.zeros((nchunk, 64))
-    part_box = np.empty((nchunk, 64, 4))
-    part_box[:, :, :2] = np.inf
-    part_box[:, :, 2:] = -np.inf
-    part_top = np.zeros(nchunk, dtype=np.int64)
-    for c in prange(nchunk):
-        for i in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            lv = 0
-            if h[i] > h_c:
-                lv = min(int(math.ceil(math.log2(h[i] / h_c))), 63)
-            level[i] = lv
-            part_hmax[c, lv] = max(part_hmax[c, lv], h[i])
-            part_box[c, lv, 0] = min(part_box[c, lv, 0], x[i])
-            part_box[c, lv, 1] = min(part_box[c, lv, 1], y[i])
-            part_box[c, lv, 2] = max(part_box[c, lv, 2], x[i])
-            part_box[c, lv, 3] = max(part_box[c, lv, 3], y[i])
-            part_top[c] = max(part_top[c], lv)
-    top = part_top.max()
-    hmax = np.zeros(top + 1)
-    box = np.empty((top + 1, 4))
+    hmax = np.zeros(64)
+    box = np.empty((64, 4))
     box[:, :2] = np.inf
     box[:, 2:] = -np.inf
-    for c in range(nchunk):
-        for lv in range(top + 1):
-            hmax[lv] = max(hmax[lv], part_hmax[c, lv])
-            box[lv, 0] = min(box[lv, 0], part_box[c, lv, 0])
-            box[lv, 1] = min(box[lv, 1], part_box[c, lv, 1])
-            box[lv, 2] = max(box[lv, 2], part_box[c, lv, 2])
-            box[lv, 3] = max(box[lv, 3], part_box[c, lv, 3])
-    return hmax, box
+    top = 0
+    for i in range(h.shape[0]):
+        lv = 0
+        if h[i] > h_c:
+            lv = min(int(math.ceil(math.log2(h[i] / h_c))), 63)
+        level[i] = lv
+        hmax[lv] = max(hmax[lv], h[i])
+        box[lv, 0] = min(box[lv, 0], x[i])
+        box[lv, 1] = min(box[lv, 1], y[i])
+        box[lv, 2] = max(box[lv, 2], x[i])
+        box[lv, 3] = max(box[lv, 3], y[i])
+        top = max(top, lv)
+    return hmax[: top + 1], box[: top + 1]
 
 
 @njit(parallel=True, cache=True)

@@ -53,13 +53,12 @@ class NearWalls(NamedTuple):
 
 
 class DriftTable(NamedTuple):
-    """Candidate segments of a drift (``floodsph.walls.sight.drift``): a grid of ``nbx`` x
-    ``nby`` square buckets of side ``bucket`` [m] from (``xmin``, ``ymin``), bucket b listing
-    ``items[start[b]:start[b + 1]]`` (in increasing index): every segment whose bounding box
-    widened by ``radius`` [m] overlaps it."""
+    """A grid of candidate segments for the drift (``floodsph.walls.sight.drift``): ``nbx``
+    x ``nby`` square buckets of side ``bucket`` [m] from (``xmin``, ``ymin``), bucket b
+    listing ``items[start[b]:start[b + 1]]`` of the index's ``drift_items`` (in increasing
+    index): every segment whose bounding box widened by ``radius`` [m] overlaps it."""
 
     start: np.ndarray
-    items: np.ndarray
     xmin: float
     ymin: float
     bucket: float
@@ -152,19 +151,21 @@ class WallIndex:
             self.xmin, self.ymin, fine, fine_nbx, fine_nby)
         fine_start = np.zeros(fine_nbx * fine_nby + 1, dtype=np.int64)
         np.cumsum(fine_counts, out=fine_start[1:])
+        # one array of the drift's candidates: the fine table's, the near table's, then every
+        # segment (for the longest moves)
+        self.drift_items = np.concatenate([fine_items, self.near_items,
+                                           np.arange(self.seg.shape[0], dtype=np.int64)])
         self.drift_tables = (
-            DriftTable(fine_start, fine_items, self.xmin, self.ymin, fine, fine_nbx, fine_nby,
-                       fine),
-            DriftTable(self.near_start, self.near_items, self.xmin, self.ymin, sizes[0], nbx,
-                       nby, self.near_radius))
-        self.every = np.arange(self.seg.shape[0], dtype=np.int64)
+            DriftTable(fine_start, self.xmin, self.ymin, fine, fine_nbx, fine_nby, fine),
+            DriftTable(self.near_start + fine_items.shape[0], self.xmin, self.ymin, sizes[0],
+                       nbx, nby, self.near_radius))
         self.width = 16  # row width of the near-segment scan, widened when a row overflows
 
     def drift(self, x, y, u, v, dt: float) -> int:
         """Drift x <- x + dt v [m], reflecting the moves that would cross a segment
         (``floodsph.walls.sight.drift``, with this index's :class:`DriftTable` s: the fine
         buckets', then the level-0 buckets' candidates); returns the number of reflections."""
-        return int(drift(x, y, u, v, dt, self.seg, *self.drift_tables, self.every))
+        return int(drift(x, y, u, v, dt, self.seg, *self.drift_tables, self.drift_items))
 
     def near_lists(self, x, y, h, nstart, nbr, reach, rows=None):
         """The :class:`NearWalls` lists of the segments within each particle's reach, and of its

@@ -111,7 +111,7 @@ def _bucket_of(px, py, xmin, ymin, inv_bucket, nbx, nby):
 
 
 @njit(parallel=True, cache=True)
-def drift(x, y, u, v, dt, seg, fine, near, every):
+def drift(x, y, u, v, dt, seg, fine, near, items):
     """Drift x <- x + dt v, reflecting moves that cross a wall. Returns the reflection count.
 
     A move x_old -> x that crosses a segment is mirrored about the segment's line and the
@@ -119,18 +119,20 @@ def drift(x, y, u, v, dt, seg, fine, near, every):
     put back to x_old with zero velocity. The segments tested, in increasing index, are the
     candidates of x_old's bucket in the ``fine`` candidate table of
     ``floodsph.walls.index.WallIndex`` (a ``DriftTable``: buckets of side ``bucket`` [m],
-    each listing every segment whose box widened by ``radius`` [m] overlaps it) if the move's
-    length L is below ``NEAR_SHARE`` times its radius, else in the ``near`` table on the same
-    terms: each point of the move, and of its reflections, lies within L of x_old, so they
-    hold every segment the move can cross. A longer move, or one from outside the buckets,
-    tests ``every`` segment.
+    bucket b listing ``items[start[b]:start[b + 1]]``, every segment whose box widened by
+    ``radius`` [m] overlaps it) if the move's length L is below ``NEAR_SHARE`` times its
+    radius, else in the ``near`` table on the same terms: each point of the move, and of its
+    reflections, lies within L of x_old, so they hold every segment the move can cross. A
+    longer move, or one from outside the buckets, tests every segment, the last
+    ``seg.shape[0]`` entries of ``items``.
     """
-    f_start, f_items, xmin, ymin, f_bucket, f_nbx, f_nby, f_radius = fine
-    n_start, n_items, _, _, n_bucket, n_nbx, n_nby, n_radius = near
+    f_start, xmin, ymin, f_bucket, f_nbx, f_nby, f_radius = fine
+    n_start, _, _, n_bucket, n_nbx, n_nby, n_radius = near
     f_reach2 = (NEAR_SHARE * f_radius) ** 2
     n_reach2 = (NEAR_SHARE * n_radius) ** 2
     f_inv = 1.0 / f_bucket
     n_inv = 1.0 / n_bucket
+    every = items.shape[0] - seg.shape[0]
     total = 0
     for i in prange(x.shape[0]):
         x_old = x[i]
@@ -138,28 +140,20 @@ def drift(x, y, u, v, dt, seg, fine, near, every):
         x[i] = x_old + dt * u[i]
         y[i] = y_old + dt * v[i]
         travel2 = (x[i] - x_old) ** 2 + (y[i] - y_old) ** 2
-        table = 0  # 1: the fine buckets' candidates, 2: the near ones', 0: every segment
-        lo = 0
-        hi = every.shape[0]
+        lo = every
+        hi = items.shape[0]
         b = _bucket_of(x_old, y_old, xmin, ymin, f_inv, f_nbx, f_nby)
         if b >= 0 and travel2 < f_reach2:
-            table = 1
             lo = f_start[b]
             hi = f_start[b + 1]
         else:
             b = _bucket_of(x_old, y_old, xmin, ymin, n_inv, n_nbx, n_nby)
             if b >= 0 and travel2 < n_reach2:
-                table = 2
                 lo = n_start[b]
                 hi = n_start[b + 1]
         hits = 0
         while lo < hi and hits < 3:
-            if table == 1:
-                hit = _first_crossing(x_old, y_old, x[i], y[i], seg, f_items, lo, hi)
-            elif table == 2:
-                hit = _first_crossing(x_old, y_old, x[i], y[i], seg, n_items, lo, hi)
-            else:
-                hit = _first_crossing(x_old, y_old, x[i], y[i], seg, every, lo, hi)
+            hit = _first_crossing(x_old, y_old, x[i], y[i], seg, items, lo, hi)
             if hit < 0:
                 break
             hits += 1
