@@ -14,6 +14,9 @@ the sizes: ``fixed`` is the cost of a step that does not grow with the particles
 without it, each checkout's default. Each row also gives the neighbour-list builds per step
 (the model's ``neighbour_builds`` counter, where the checkout has it).
 
+``--scaling`` measures this checkout on ``--threads`` threads and on one thread, alternately
+in one process, and reports their ratio (what the second thread adds).
+
 ``--compare REF`` runs the same measurements on a second checkout in the same invocation,
 each checkout in its own worker process, alternating one measurement of each (so that both
 see the same load on a shared machine; compare them by their ratio only). REF is a path to a
@@ -22,7 +25,8 @@ once with ``git archive`` into ``--ref-dir`` (so its compiled kernels are cached
 A checkout without the stage timer reports its totals only.
 
     python benchmarks/step_cost.py [--steps 200] [--repeats 3] [--threads 1]
-        [--momentum variational|balanced] [--compare REF] [--out docs/step-cost.md] [--quick]
+        [--momentum variational|balanced] [--compare REF | --scaling]
+        [--out docs/step-cost.md] [--quick]
 """
 
 from __future__ import annotations
@@ -171,11 +175,16 @@ class Checkout:
 
 
 class InProcess:
-    """Measure with the floodsph this process imports."""
+    """Measure with the floodsph this process imports, on ``threads`` numba threads (None:
+    as they are set)."""
 
-    name = "this"
+    def __init__(self, name: str = "this", threads: int | None = None):
+        self.name = name
+        self.threads = threads
 
     def measure(self, **request) -> dict:
+        if self.threads is not None:
+            piece("set_threads")(self.threads)
         return measure(**request)
 
     def close(self) -> None:
@@ -286,6 +295,8 @@ def main(argv=None) -> int:
     ap.add_argument("--momentum", choices=("variational", "balanced"), default=None,
                     help="numerics.momentum of the dam break (default: each checkout's)")
     ap.add_argument("--compare", metavar="REF", help="a second checkout: path or commit")
+    ap.add_argument("--scaling", action="store_true",
+                    help="measure on --threads threads and on one, alternately, in one process")
     ap.add_argument("--ref-dir", type=Path,
                     default=Path(tempfile.gettempdir()) / "floodsph-step-cost",
                     help="where a commit given to --compare is extracted")
@@ -298,7 +309,16 @@ def main(argv=None) -> int:
         return worker()
     if args.quick:
         args.sizes, args.steps, args.warmup, args.repeats = [1000, 4000], 5, 2, 1
-    if args.compare:
+    if args.scaling:
+        from floodsph.run.pipeline import set_threads
+
+        threads = set_threads(args.threads)
+        if threads < 2:
+            print("Error: --scaling needs --threads of 2 or more (0: all cores)",
+                  file=sys.stderr)
+            return 2
+        checkouts = [InProcess(f"{threads} threads", threads), InProcess("1 thread", 1)]
+    elif args.compare:
         checkouts = [Checkout("this", REPO, args.threads),
                      Checkout("ref", reference_root(args.compare, args.ref_dir), args.threads)]
     else:

@@ -80,3 +80,26 @@ def test_the_balanced_form_measures_the_balanced_momentum_and_counts_the_list_bu
     assert "--momentum balanced" in text
     for r in table_rows(text, "checkout"):
         assert 0.0 < float(r["list_builds_per_step"]) <= 2.0
+
+
+def test_scaling_measures_two_threads_against_one_on_the_same_particles(tmp_path):
+    """``--scaling``: each size measured on two threads and on one in the same process, the
+    ratio being that of the two rows' particle-steps/s; one thread alone is refused."""
+    import numba
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one numba thread available")
+    out = tmp_path / "scaling.md"
+    assert step_cost.main(["--quick", "--scaling", "--threads", "2", "--out", str(out)]) == 0
+    text = out.read_text()
+    rows = table_rows(text, "checkout")
+    assert [r["checkout"] for r in rows] == ["2 threads", "2 threads", "1 thread", "1 thread"]
+    speed = {(r["checkout"], int(r["particles"])): float(r["particle_steps_per_s"])
+             for r in rows}
+    for r in table_rows(text, "particles"):
+        n = int(r["particles"])
+        assert float(r["speed 2 threads / 1 thread"]) == pytest.approx(
+            speed["2 threads", n] / speed["1 thread", n], rel=2e-3)
+    assert step_cost.main(["--quick", "--scaling", "--threads", "1",
+                           "--out", str(tmp_path / "no.md")]) == 2
+    assert not (tmp_path / "no.md").exists()
