@@ -135,22 +135,14 @@ class WallIndex:
         self.clear = _clearance(counts[0].reshape(nby, nbx) > 0, sizes[0])
         # per level-0 bucket, the segments whose box widened by near_radius overlaps it
         self.near_radius = NEAR_BUCKETS * sizes[0]
-        lo = np.minimum(self.seg[:, :2], self.seg[:, 2:]) - self.near_radius
-        hi = np.maximum(self.seg[:, :2], self.seg[:, 2:]) + self.near_radius
-        near_counts, self.near_items = _bucket_lists(np.hstack([lo, hi]), self.xmin, self.ymin,
-                                                     sizes[0], nbx, nby)
-        self.near_start = np.zeros(nbx * nby + 1, dtype=np.int64)
-        np.cumsum(near_counts, out=self.near_start[1:])
+        self.near_start, self.near_items = _candidates(self.seg, self.xmin, self.ymin,
+                                                       sizes[0], nbx, nby, self.near_radius)
         self.pstart, self.partner = _corner_partners(self.seg)
         fine = DRIFT_BUCKET * sizes[0]
         fine_nbx = max(1, int((xmax - xmin) / fine) + 1)
         fine_nby = max(1, int((ymax - ymin) / fine) + 1)
-        fine_counts, fine_items = _bucket_lists(
-            np.hstack([np.minimum(self.seg[:, :2], self.seg[:, 2:]) - fine,
-                       np.maximum(self.seg[:, :2], self.seg[:, 2:]) + fine]),
-            self.xmin, self.ymin, fine, fine_nbx, fine_nby)
-        fine_start = np.zeros(fine_nbx * fine_nby + 1, dtype=np.int64)
-        np.cumsum(fine_counts, out=fine_start[1:])
+        fine_start, fine_items = _candidates(self.seg, self.xmin, self.ymin, fine, fine_nbx,
+                                             fine_nby, fine)
         # one array of the drift's candidates: the fine table's, the near table's, then every
         # segment (for the longest moves)
         self.drift_items = np.concatenate([fine_items, self.near_items,
@@ -163,7 +155,7 @@ class WallIndex:
 
     def drift(self, x, y, u, v, dt: float) -> int:
         """Drift x <- x + dt v [m], reflecting the moves that would cross a segment
-        (``floodsph.walls.sight.drift``, with this index's :class:`DriftTable` s: the fine
+        (``floodsph.walls.sight.drift``, with this index's two :class:`DriftTable`: the fine
         buckets', then the level-0 buckets' candidates); returns the number of reflections."""
         return int(drift(x, y, u, v, dt, self.seg, *self.drift_tables, self.drift_items))
 
@@ -224,6 +216,19 @@ def _bucket_lists(seg: np.ndarray, xmin: float, ymin: float, bucket: float, nbx:
     b = (b0[sid, 1] + k // wide[sid]) * nbx + b0[sid, 0] + k % wide[sid]
     order = np.argsort(b, kind="stable")
     return np.bincount(b, minlength=nbx * nby), sid[order]
+
+
+def _candidates(seg: np.ndarray, xmin: float, ymin: float, bucket: float, nbx: int, nby: int,
+                radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """CSR table (start, items) of each bucket's candidate segments on a grid of nbx x nby
+    buckets of side ``bucket`` [m]: every segment whose bounding box widened by ``radius``
+    [m] overlaps the bucket, in increasing index (:func:`_bucket_lists`)."""
+    lo = np.minimum(seg[:, :2], seg[:, 2:]) - radius
+    hi = np.maximum(seg[:, :2], seg[:, 2:]) + radius
+    counts, items = _bucket_lists(np.hstack([lo, hi]), xmin, ymin, bucket, nbx, nby)
+    start = np.zeros(nbx * nby + 1, dtype=np.int64)
+    np.cumsum(counts, out=start[1:])
+    return start, items
 
 
 def _clearance(occupied: np.ndarray, bucket: float) -> np.ndarray:
